@@ -1,0 +1,40 @@
+/* Preconditioned conjugate gradients from x = 0 (SPEC 5).
+ *
+ * Stopping, on the preconditioned norm rho = sqrt(r^T z):
+ *  - PCG_FORCING: eta = min(0.5, sqrt(max(rho0, tau))), stop when rho < eta rho0
+ *    (the inexact-Newton forcing term of HOT §5 / reference §4);
+ *  - PCG_ABSOLUTE: stop when rho < abs_tol (coarse solves, LBFGS-H: abs_tol
+ *    = 1/2 sqrt(bbar^T D^-1 bbar), reference §5.3).
+ * The check is at the top of each iteration; at most max_iters iterations.
+ * Vectors r, z and the search direction are kept in the projected subspace. */
+#ifndef MPM_PCG_H
+#define MPM_PCG_H
+
+#include "solvers/inverse_approx.h"
+
+typedef enum { PCG_FORCING = 0, PCG_ABSOLUTE = 1 } PcgStop;
+
+typedef struct {
+    PcgStop stop;
+    double tau;      /* PCG_FORCING floor */
+    double abs_tol;  /* PCG_ABSOLUTE */
+    int max_iters;   /* 10000 in every reference configuration */
+} PcgOptions;
+
+typedef struct {
+    int iters;
+    int capped;      /* hit max_iters */
+    double rho0, rho;
+} PcgResult;
+
+/* Work arrays are kept inside and reused (allocate once per size). */
+typedef struct {
+    int cap_nodes;
+    double *r, *z, *p, *q;
+} PcgWork;
+
+int pcg_solve(const LinearOp *A, InvApprox *M, const Projection *proj, const double *b, double *x,
+              const PcgOptions *opt, PcgWork *work, PcgResult *res);
+void pcg_work_free(PcgWork *w);
+
+#endif
