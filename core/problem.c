@@ -1,0 +1,651 @@
+#include "core/problem.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "core/fcr.h"
+#include "core/mat3.h"
+
+#define MAX_THREADS 256
+#define NEIGH 125
+
+/* Offset index of node (i + d), d in [-2,2]^3, in a row's 125 slots. */
+static inline int neigh_index(int dx, int dy, int dz) { return 25 * (dx + 2) + 5 * (dy + 2) + (dz + 2); }
+
+/* Offset index between stencil slots s and t of one particle. */
+static int g_pair_offset[27][27];
+static void init_pair_offsets(void)
+{
+    static int done = 0;
+    if (done) return;
+    for (int s = 0; s < 27; ++s)
+        for (int t = 0; t < 27; ++t)
+            g_pair_offset[s][t] = neigh_index(t / 9 - s / 9, (t / 3) % 3 - (s / 3) % 3, t % 3 - s % 3);
+    done = 1;
+}
+
+static int grow(void **ptr, size_t bytes)
+{
+    void *q = realloc(*ptr, bytes);
+    if (!q) return mpm_error(MPM_EINTERNAL, "out of memory (%zu bytes) in the step problem", bytes);
+    *ptr = q;
+    return MPM_OK;
+}
+
+static int ensure_capacity(StepProblem *pb, size_t np, int nn)
+{
+    int st = 0;
+    if (np > pb->cap_particles) {
+        size_t c = np + np / 4 + 256;
+        st |= grow((void **)&pb->a, sizeof(double) * 81 * c);
+        st |= grow((void **)&pb->mu, sizeof(double) * c);
+        st |= grow((void **)&pb->lambda, sizeof(double) * c);
+        st |= grow((void **)&pb->stiff, sizeof(double) * c);
+        st |= grow((void **)&pb->F, sizeof(double) * 9 * c);
+        st |= grow((void **)&pb->P, sizeof(double) * 9 * c);
+        st |= grow((void **)&pb->A, sizeof(double) * 81 * c);
+        if (st) return MPM_EINTERNAL;
+        pb->cap_particles = c;
+    }
+    if (nn > pb->cap_nodes) {
+        size_t c = (size_t)nn + (size_t)nn / 4 + 256;
+        st |= grow((void **)&pb->bc, c);
+        st |= grow((void **)&pb->bc_P, sizeof(double) * 9 * c);
+        st |= grow((void **)&pb->dv0, sizeof(double) * 3 * c);
+        st |= grow((void **)&pb->kappa, sizeof(double) * c);
+        st |= grow((void **)&pb->slot, sizeof(short) * NEIGH * c);
+        st |= grow((void **)&pb->rowmask, sizeof(uint64_t) * 2 * c);
+        st |= grow((void **)&pb->tmp, sizeof(double) * 3 * c);
+        if (st) return MPM_EINTERNAL;
+        pb->cap_nodes = (int)c;
+    }
+    return MPM_OK;
+}
+
+int problem_prepare(StepProblem *pb, const Grid *g, const Stencils *st, const Particles *p,
+                    const Material *mats, int n_mats, double dt, const double gravity[3])
+{
+    init_pair_offsets();
+    int status = ensure_capacity(pb, p->n, g->n);
+    if (status) return status;
+    pb->n_nodes = g->n;
+    pb->n_particles = p->n;
+    pb->dt = dt;
+    pb->dx = g->dx;
+    memcpy(pb->gravity, gravity, sizeof pb->gravity);
+    pb->grid = g;
+    pb->st = st;
+    pb->parts = p;
+    pb->mats = mats;
+    pb->n_mats = n_mats;
+    pb->pattern_ready = 0;
+    pb->n_dirichlet = 0;
+
+    double maxstiff = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : maxstiff)
+    for (size_t k = 0; k < p->n; ++k) {
+        const Material *m = &mats[p->mat[k]];
+        double h = 1.0;
+        if (p->Jp && m->plasticity == PLASTICITY_SNOW && m->hardening > 0.0) h = exp(m->hardening * (1.0 - p->Jp[k]));
+        pb->mu[k] = h * m->mu;
+        pb->lambda[k] = h * m->lambda;
+        pb->stiff[k] = fcr_rest_stiffness(pb->mu[k], pb->lambda[k]);
+        if (pb->stiff[k] > maxstiff) maxstiff = pb->stiff[k];
+        /* a_ip = F^nT grad w_ip */
+        const double *Fn = p->F + 9 * k, *dw = st->dw + 81 * k;
+        double *a = pb->a + 81 * k;
+        for (int s = 0; s < 27; ++s) {
+            const double *gw = dw + 3 * s;
+            for (int b = 0; b < 3; ++b) a[3 * s + b] = Fn[b] * gw[0] + Fn[3 + b] * gw[1] + Fn[6 + b] * gw[2];
+        }
+    }
+    pb->max_stiffness = maxstiff;
+
+    /* CN scale: kappa_i = 24 dx^2 dt abar_i, abar_i = sum_p w_ip m_p a_p / m_i
+     * (SPEC 4, HOT §5.2). Scatter by particle-block colour. */
+    double *num = pb->kappa;
+    memset(num, 0, sizeof(double) * (size_t)g->n);
+    const NodeColoring *pc = &st->pcolor;
+    for (int c = 0; c < MPM_NUM_COLORS; ++c) {
+#pragma omp parallel for schedule(dynamic, 4)
+        for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
+            int q = pc->color_blocks[qi];
+            for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
+                const int *node = st->node + 27 * (size_t)k;
+                const double *w = st->w + 27 * (size_t)k;
+                double s = p->mass[k] * pb->stiff[k];
+                for (int t = 0; t < 27; ++t)
+                    if (node[t] >= 0) num[node[t]] += w[t] * s;
+            }
+        }
+    }
+    double min_pos = INFINITY;
+    for (int i = 0; i < g->n; ++i) {
+        double abar = num[i] / g->mass[i];
+        num[i] = abar;
+        if (abar > 0.0 && abar < min_pos) min_pos = abar;
+    }
+    if (!isfinite(min_pos)) min_pos = 1.0; /* no elastic particle at all: plain residual */
+    double scale = 24.0 * pb->dx * pb->dx * dt;
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < g->n; ++i) {
+        double abar = num[i] > 0.0 ? num[i] : min_pos; /* SPEC 4 guard */
+        pb->kappa[i] = scale * abar;
+    }
+    memset(pb->bc, BC_FREE, (size_t)g->n);
+    /* initial guess of free nodes: dt g (HOT reference §1.3) */
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < g->n; ++i)
+        for (int d = 0; d < 3; ++d) pb->dv0[3 * i + d] = dt * gravity[d];
+    return MPM_OK;
+}
+
+void problem_set_dirichlet(StepProblem *pb, int i, const double v_target[3], const double normal[3])
+{
+    const double *vn = pb->grid->v + 3 * (size_t)i;
+    double *P = pb->bc_P + 9 * (size_t)i;
+    double *dv0 = pb->dv0 + 3 * (size_t)i;
+    if (!normal) {
+        pb->bc[i] = BC_STICKY;
+        memset(P, 0, 9 * sizeof(double));
+        for (int d = 0; d < 3; ++d) dv0[d] = v_target[d] - vn[d];
+        return;
+    }
+    if (pb->bc[i] == BC_STICKY) return;
+    double n[3] = {normal[0], normal[1], normal[2]};
+    if (pb->bc[i] == BC_FREE) m3_identity(P);
+    /* Gram-Schmidt against normals already removed: n <- P n. */
+    double pn[3];
+    m3_mulv(P, n, pn);
+    double len = v3_norm(pn);
+    pb->bc[i] = BC_SLIP;
+    if (len < 1e-8) return; /* already constrained along n */
+    for (int d = 0; d < 3; ++d) pn[d] /= len;
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) P[3 * r + c] -= pn[r] * pn[c];
+    /* the normal component of v^{n+1} becomes the collider's: dv.n = (v_target - v^n).n */
+    double cur = v3_dot(dv0, pn), want = v3_dot(v_target, pn) - v3_dot(vn, pn);
+    for (int d = 0; d < 3; ++d) dv0[d] += (want - cur) * pn[d];
+}
+
+void problem_initial_guess(const StepProblem *pb, double *dv)
+{
+    memcpy(dv, pb->dv0, sizeof(double) * 3 * (size_t)pb->n_nodes);
+}
+
+static inline void project_node(const StepProblem *pb, int i, double *v)
+{
+    unsigned char b = pb->bc[i];
+    if (b == BC_FREE) return;
+    if (b == BC_STICKY) {
+        v[0] = v[1] = v[2] = 0.0;
+        return;
+    }
+    m3_mulv(pb->bc_P + 9 * (size_t)i, v, v);
+}
+
+void problem_project(const StepProblem *pb, double *v)
+{
+    if (pb->n_dirichlet == 0) return;
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < pb->n_nodes; ++i) project_node(pb, i, v + 3 * (size_t)i);
+}
+
+/* Sum of per-thread partials in thread order: deterministic for a fixed
+ * thread count. */
+typedef struct {
+    double v[MAX_THREADS];
+    int nt;
+} Partials;
+
+double problem_energy(StepProblem *pb, const double *dv)
+{
+    const Particles *p = pb->parts;
+    const Stencils *st = pb->st;
+    const double *vn = pb->grid->v;
+    double dt = pb->dt;
+    Partials part = {{0}, 1};
+#pragma omp parallel
+    {
+        int t = omp_get_thread_num();
+#pragma omp single
+        part.nt = omp_get_num_threads();
+        double e = 0.0;
+#pragma omp for schedule(static)
+        for (size_t k = 0; k < p->n; ++k) {
+            const int *node = st->node + 27 * k;
+            const double *a = pb->a + 81 * k;
+            double *F = pb->F + 9 * k;
+            m3_copy(F, p->F + 9 * k);
+            for (int s = 0; s < 27; ++s) {
+                int i = node[s];
+                if (i < 0) continue;
+                double u0 = dt * (vn[3 * i] + dv[3 * i]), u1 = dt * (vn[3 * i + 1] + dv[3 * i + 1]),
+                       u2 = dt * (vn[3 * i + 2] + dv[3 * i + 2]);
+                const double *as = a + 3 * s;
+                F[0] += u0 * as[0]; F[1] += u0 * as[1]; F[2] += u0 * as[2];
+                F[3] += u1 * as[0]; F[4] += u1 * as[1]; F[5] += u1 * as[2];
+                F[6] += u2 * as[0]; F[7] += u2 * as[1]; F[8] += u2 * as[2];
+            }
+            e += p->vol[k] * fcr_psi_P(F, pb->mu[k], pb->lambda[k], pb->P + 9 * k);
+        }
+        if (t < MAX_THREADS) part.v[t] = e;
+    }
+    double elastic = 0.0;
+    for (int t = 0; t < part.nt && t < MAX_THREADS; ++t) elastic += part.v[t];
+    pb->elastic_energy = elastic;
+
+    const double *m = pb->grid->mass;
+    const double *g = pb->gravity;
+    Partials kin = {{0}, 1};
+#pragma omp parallel
+    {
+        int t = omp_get_thread_num();
+#pragma omp single
+        kin.nt = omp_get_num_threads();
+        double e = 0.0;
+#pragma omp for schedule(static)
+        for (int i = 0; i < pb->n_nodes; ++i) {
+            const double *d = dv + 3 * (size_t)i;
+            e += m[i] * (0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - dt * (g[0] * d[0] + g[1] * d[1] + g[2] * d[2]));
+        }
+        if (t < MAX_THREADS) kin.v[t] = e;
+    }
+    double inertial = 0.0;
+    for (int t = 0; t < kin.nt && t < MAX_THREADS; ++t) inertial += kin.v[t];
+    return inertial + elastic;
+}
+
+void problem_gradient(StepProblem *pb, const double *dv, double *grad)
+{
+    const Particles *p = pb->parts;
+    const Stencils *st = pb->st;
+    const double *m = pb->grid->mass;
+    double dt = pb->dt;
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < pb->n_nodes; ++i)
+        for (int d = 0; d < 3; ++d) grad[3 * i + d] = m[i] * (dv[3 * i + d] - dt * pb->gravity[d]);
+    const NodeColoring *pc = &st->pcolor;
+    for (int c = 0; c < MPM_NUM_COLORS; ++c) {
+#pragma omp parallel for schedule(dynamic, 4)
+        for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
+            int q = pc->color_blocks[qi];
+            for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
+                const int *node = st->node + 27 * (size_t)k;
+                const double *a = pb->a + 81 * (size_t)k, *P = pb->P + 9 * (size_t)k;
+                double s = dt * p->vol[k];
+                for (int t = 0; t < 27; ++t) {
+                    int i = node[t];
+                    if (i < 0) continue;
+                    double f[3];
+                    m3_mulv(P, a + 3 * t, f);
+                    grad[3 * i] += s * f[0];
+                    grad[3 * i + 1] += s * f[1];
+                    grad[3 * i + 2] += s * f[2];
+                }
+            }
+        }
+    }
+    problem_project(pb, grad);
+}
+
+int problem_tangent(StepProblem *pb, int projected)
+{
+    const Particles *p = pb->parts;
+#pragma omp parallel for schedule(static)
+    for (size_t k = 0; k < p->n; ++k) fcr_dPdF(pb->F + 9 * k, pb->mu[k], pb->lambda[k], projected, pb->A + 81 * k);
+    pb->tangent_projected = projected;
+    return MPM_OK;
+}
+
+/* B_s[a][3c+d] = sum_b A[(a,b),(c,d)] a_s(b): the particle tangent contracted
+ * with one node's a-vector (3 x 9). */
+static inline void contract_left(const double *A, const double as[3], double B[27])
+{
+    for (int al = 0; al < 3; ++al) {
+        const double *r0 = A + 9 * (3 * al), *r1 = r0 + 9, *r2 = r1 + 9;
+        double *Bo = B + 9 * al;
+        for (int e = 0; e < 9; ++e) Bo[e] = r0[e] * as[0] + r1[e] * as[1] + r2[e] * as[2];
+    }
+}
+
+/* K[a][c] = sum_d B[a][3c+d] a_t(d) */
+static inline void contract_right(const double B[27], const double at[3], double s, double K[9])
+{
+    for (int al = 0; al < 3; ++al)
+        for (int c = 0; c < 3; ++c) {
+            const double *b = B + 9 * al + 3 * c;
+            K[3 * al + c] = s * (b[0] * at[0] + b[1] * at[1] + b[2] * at[2]);
+        }
+}
+
+static int build_pattern(StepProblem *pb, Bsr *H)
+{
+    const Stencils *st = pb->st;
+    const Grid *g = pb->grid;
+    int n = pb->n_nodes;
+    memset(pb->rowmask, 0, sizeof(uint64_t) * 2 * (size_t)n);
+    const NodeColoring *pc = &st->pcolor;
+    for (int c = 0; c < MPM_NUM_COLORS; ++c) {
+#pragma omp parallel for schedule(dynamic, 4)
+        for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
+            int q = pc->color_blocks[qi];
+            for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
+                const int *node = st->node + 27 * (size_t)k;
+                for (int s = 0; s < 27; ++s) {
+                    int i = node[s];
+                    if (i < 0) continue;
+                    uint64_t *rm = pb->rowmask + 2 * (size_t)i;
+                    for (int t = 0; t < 27; ++t) {
+                        if (node[t] < 0) continue;
+                        int o = g_pair_offset[s][t];
+                        rm[o >> 6] |= 1ull << (o & 63);
+                    }
+                }
+            }
+        }
+    }
+    /* row pointers */
+    int status = bsr_reserve(H, n, 0);
+    if (status) return status;
+    H->row_ptr[0] = 0;
+    for (int i = 0; i < n; ++i)
+        H->row_ptr[i + 1] = H->row_ptr[i] + __builtin_popcountll(pb->rowmask[2 * i]) +
+                            __builtin_popcountll(pb->rowmask[2 * i + 1]);
+    if ((status = bsr_reserve(H, n, H->row_ptr[n]))) return status;
+    H->nnzb = H->row_ptr[n];
+    /* columns sorted by node id; slot table maps offsets to row positions */
+#pragma omp parallel for schedule(dynamic, 64)
+    for (int i = 0; i < n; ++i) {
+        int cols[NEIGH], offs[NEIGH], m = 0;
+        const int *ci = g->coord + 3 * (size_t)i;
+        short *slot = pb->slot + NEIGH * (size_t)i;
+        for (int o = 0; o < NEIGH; ++o) {
+            slot[o] = -1;
+            if (!((pb->rowmask[2 * (size_t)i + (o >> 6)] >> (o & 63)) & 1u)) continue;
+            int cj[3] = {ci[0] + o / 25 - 2, ci[1] + (o / 5) % 5 - 2, ci[2] + o % 5 - 2};
+            int j = grid_lookup(g, cj);
+            /* insertion sort by column id */
+            int pos = m++;
+            while (pos > 0 && cols[pos - 1] > j) {
+                cols[pos] = cols[pos - 1];
+                offs[pos] = offs[pos - 1];
+                --pos;
+            }
+            cols[pos] = j;
+            offs[pos] = o;
+        }
+        int64_t r0 = H->row_ptr[i];
+        for (int k = 0; k < m; ++k) {
+            H->col[r0 + k] = cols[k];
+            slot[offs[k]] = (short)k;
+        }
+    }
+    bsr_update_pattern_id(H);
+    pb->pattern_ready = 1;
+    return MPM_OK;
+}
+
+/* Applies P_i (.) P_j to block B (row i, column j) in place. */
+static inline void project_block(const StepProblem *pb, int i, int j, double *B)
+{
+    unsigned char bi = pb->bc[i], bj = pb->bc[j];
+    if (bi == BC_STICKY || bj == BC_STICKY) {
+        memset(B, 0, 9 * sizeof(double));
+        return;
+    }
+    if (bi == BC_SLIP) m3_mul(pb->bc_P + 9 * (size_t)i, B, B);
+    if (bj == BC_SLIP) m3_mul(B, pb->bc_P + 9 * (size_t)j, B);
+}
+
+/* Adds I - P_i to a diagonal block (BC-projected Hessian). */
+static inline void add_complement(const StepProblem *pb, int i, double *B)
+{
+    unsigned char b = pb->bc[i];
+    if (b == BC_FREE) return;
+    if (b == BC_STICKY) {
+        B[0] += 1.0;
+        B[4] += 1.0;
+        B[8] += 1.0;
+        return;
+    }
+    const double *P = pb->bc_P + 9 * (size_t)i;
+    for (int e = 0; e < 9; ++e) B[e] += ((e % 4 == 0) ? 1.0 : 0.0) - P[e];
+}
+
+int problem_assemble(StepProblem *pb, Bsr *H)
+{
+    int status;
+    if (!pb->pattern_ready || H->n != pb->n_nodes) {
+        if ((status = build_pattern(pb, H))) return status;
+    }
+    const Stencils *st = pb->st;
+    const Particles *p = pb->parts;
+    double dt2 = pb->dt * pb->dt;
+    memset(H->val, 0, sizeof(double) * 9 * (size_t)H->nnzb);
+    const NodeColoring *pc = &st->pcolor;
+    for (int c = 0; c < MPM_NUM_COLORS; ++c) {
+#pragma omp parallel for schedule(dynamic, 2)
+        for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
+            int q = pc->color_blocks[qi];
+            double B[27], K[9];
+            for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
+                const int *node = st->node + 27 * (size_t)k;
+                const double *a = pb->a + 81 * (size_t)k, *A = pb->A + 81 * (size_t)k;
+                double s = dt2 * p->vol[k];
+                for (int si = 0; si < 27; ++si) {
+                    int i = node[si];
+                    if (i < 0) continue;
+                    contract_left(A, a + 3 * si, B);
+                    const short *slot_i = pb->slot + NEIGH * (size_t)i;
+                    int64_t r0 = H->row_ptr[i];
+                    for (int ti = si; ti < 27; ++ti) {
+                        int j = node[ti];
+                        if (j < 0) continue;
+                        contract_right(B, a + 3 * ti, s, K);
+                        double *Hij = H->val + 9 * (r0 + slot_i[g_pair_offset[si][ti]]);
+                        for (int e = 0; e < 9; ++e) Hij[e] += K[e];
+                        if (ti != si) {
+                            double *Hji = H->val + 9 * (H->row_ptr[j] + pb->slot[NEIGH * (size_t)j + g_pair_offset[ti][si]]);
+                            for (int r = 0; r < 3; ++r)
+                                for (int cc = 0; cc < 3; ++cc) Hji[3 * r + cc] += K[3 * cc + r];
+                        }
+                    }
+                }
+            }
+        }
+    }
+    /* mass and boundary conditions */
+    const double *m = pb->grid->mass;
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < pb->n_nodes; ++i) {
+        for (int64_t k = H->row_ptr[i]; k < H->row_ptr[i + 1]; ++k) {
+            double *Bk = H->val + 9 * k;
+            int j = H->col[k];
+            if (j == i) {
+                Bk[0] += m[i];
+                Bk[4] += m[i];
+                Bk[8] += m[i];
+            }
+            if (pb->bc[i] != BC_FREE || pb->bc[j] != BC_FREE) project_block(pb, i, j, Bk);
+            if (j == i) add_complement(pb, i, Bk);
+        }
+    }
+    return MPM_OK;
+}
+
+void problem_hessvec(StepProblem *pb, const double *x, double *y)
+{
+    const Stencils *st = pb->st;
+    const Particles *p = pb->parts;
+    const double *m = pb->grid->mass;
+    double dt2 = pb->dt * pb->dt;
+    int n = pb->n_nodes;
+    const double *xp = x;
+    if (pb->n_dirichlet) {
+        memcpy(pb->tmp, x, sizeof(double) * 3 * (size_t)n);
+        problem_project(pb, pb->tmp);
+        xp = pb->tmp;
+    }
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < n; ++i)
+        for (int d = 0; d < 3; ++d) y[3 * i + d] = m[i] * xp[3 * i + d];
+    const NodeColoring *pc = &st->pcolor;
+    for (int c = 0; c < MPM_NUM_COLORS; ++c) {
+#pragma omp parallel for schedule(dynamic, 4)
+        for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
+            int q = pc->color_blocks[qi];
+            for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
+                const int *node = st->node + 27 * (size_t)k;
+                const double *a = pb->a + 81 * (size_t)k, *A = pb->A + 81 * (size_t)k;
+                /* dF = sum_j x_j a_j^T (SPEC 3 "G2P of x") */
+                double G[9] = {0};
+                for (int t = 0; t < 27; ++t) {
+                    int j = node[t];
+                    if (j < 0) continue;
+                    const double *xj = xp + 3 * (size_t)j, *at = a + 3 * t;
+                    for (int r = 0; r < 3; ++r)
+                        for (int cc = 0; cc < 3; ++cc) G[3 * r + cc] += xj[r] * at[cc];
+                }
+                double dP[9];
+                for (int e = 0; e < 9; ++e) {
+                    const double *row = A + 9 * e;
+                    double s = 0.0;
+                    for (int f = 0; f < 9; ++f) s += row[f] * G[f];
+                    dP[e] = s;
+                }
+                double s = dt2 * p->vol[k];
+                for (int t = 0; t < 27; ++t) {
+                    int i = node[t];
+                    if (i < 0) continue;
+                    double f[3];
+                    m3_mulv(dP, a + 3 * t, f);
+                    y[3 * i] += s * f[0];
+                    y[3 * i + 1] += s * f[1];
+                    y[3 * i + 2] += s * f[2];
+                }
+            }
+        }
+    }
+    if (pb->n_dirichlet) {
+#pragma omp parallel for schedule(static)
+        for (int i = 0; i < n; ++i) {
+            if (pb->bc[i] == BC_FREE) continue;
+            double *yi = y + 3 * (size_t)i;
+            const double *xi = x + 3 * (size_t)i;
+            project_node(pb, i, yi);
+            if (pb->bc[i] == BC_STICKY) {
+                yi[0] = xi[0];
+                yi[1] = xi[1];
+                yi[2] = xi[2];
+            } else {
+                double px[3];
+                m3_mulv(pb->bc_P + 9 * (size_t)i, xi, px);
+                for (int d = 0; d < 3; ++d) yi[d] += xi[d] - px[d];
+            }
+        }
+    }
+}
+
+void problem_diagonal(StepProblem *pb, double *D)
+{
+    const Stencils *st = pb->st;
+    const Particles *p = pb->parts;
+    const double *m = pb->grid->mass;
+    double dt2 = pb->dt * pb->dt;
+    int n = pb->n_nodes;
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < n; ++i) {
+        double *Di = D + 9 * (size_t)i;
+        memset(Di, 0, 9 * sizeof(double));
+        Di[0] = Di[4] = Di[8] = m[i];
+    }
+    const NodeColoring *pc = &st->pcolor;
+    for (int c = 0; c < MPM_NUM_COLORS; ++c) {
+#pragma omp parallel for schedule(dynamic, 4)
+        for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
+            int q = pc->color_blocks[qi];
+            double B[27], K[9];
+            for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
+                const int *node = st->node + 27 * (size_t)k;
+                const double *a = pb->a + 81 * (size_t)k, *A = pb->A + 81 * (size_t)k;
+                double s = dt2 * p->vol[k];
+                for (int t = 0; t < 27; ++t) {
+                    int i = node[t];
+                    if (i < 0) continue;
+                    contract_left(A, a + 3 * t, B);
+                    contract_right(B, a + 3 * t, s, K);
+                    double *Di = D + 9 * (size_t)i;
+                    for (int e = 0; e < 9; ++e) Di[e] += K[e];
+                }
+            }
+        }
+    }
+    if (pb->n_dirichlet) {
+#pragma omp parallel for schedule(static)
+        for (int i = 0; i < n; ++i) {
+            if (pb->bc[i] == BC_FREE) continue;
+            double *Di = D + 9 * (size_t)i;
+            project_block(pb, i, i, Di);
+            add_complement(pb, i, Di);
+        }
+    }
+}
+
+void problem_finish_dirichlet(StepProblem *pb)
+{
+    int count = 0;
+#pragma omp parallel for schedule(static) reduction(+ : count)
+    for (int i = 0; i < pb->n_nodes; ++i) count += pb->bc[i] != BC_FREE;
+    pb->n_dirichlet = count;
+}
+
+double problem_cn_residual(const StepProblem *pb, const double *g)
+{
+    double part[MAX_THREADS] = {0};
+    int nt = 1;
+#pragma omp parallel
+    {
+        int t = omp_get_thread_num();
+#pragma omp single
+        nt = omp_get_num_threads();
+        double s = 0.0;
+#pragma omp for schedule(static)
+        for (int i = 0; i < pb->n_nodes; ++i) {
+            const double *gi = g + 3 * (size_t)i;
+            double k = pb->kappa[i];
+            s += (gi[0] * gi[0] + gi[1] * gi[1] + gi[2] * gi[2]) / (k * k);
+        }
+        if (t < MAX_THREADS) part[t] = s;
+    }
+    double s = 0.0;
+    for (int t = 0; t < nt && t < MAX_THREADS; ++t) s += part[t];
+    return pb->n_nodes > 0 ? sqrt(s / pb->n_nodes) : 0.0;
+}
+
+double problem_tau(const StepProblem *pb, double eps)
+{
+    return eps * pb->dt * 24.0 * sqrt((double)pb->n_nodes) * pb->dx * pb->dx * pb->max_stiffness;
+}
+
+void problem_free(StepProblem *pb)
+{
+    free(pb->a);
+    free(pb->mu);
+    free(pb->lambda);
+    free(pb->stiff);
+    free(pb->bc);
+    free(pb->bc_P);
+    free(pb->dv0);
+    free(pb->kappa);
+    free(pb->F);
+    free(pb->P);
+    free(pb->A);
+    free(pb->slot);
+    free(pb->rowmask);
+    free(pb->tmp);
+    memset(pb, 0, sizeof *pb);
+}

@@ -1,0 +1,123 @@
+/* The step problem: the incremental potential of one implicit timestep and
+ * everything a solver may ask of it (SPEC 3, 4; HOT reference §1.4-1.6).
+ *
+ *   E(dv) = sum_i 1/2 m_i |dv_i|^2 - dt sum_i m_i g.dv_i + sum_p V_p psi(F_p(dv))
+ *   F_p(dv) = F_p^n + dt sum_i (v_i^n + dv_i) a_ip^T,   a_ip = F_p^nT grad w_ip
+ *   g_i = m_i dv_i - dt m_i g + dt sum_p V_p P(F_p) a_ip
+ *   H = M + dt^2 K,  [K_ij]_ac = sum_p V_p sum_bd A_p[(a,b),(c,d)] a_ip(b) a_jp(d)
+ *
+ * The sign convention is the gradient g = dE/d(dv) (not the reference's
+ * residual r = -g). Dirichlet nodes (sticky or slip colliders) are handled by
+ * the per-node projector P_i (0 for sticky, I - n n^T for slip): gradients and
+ * directions are projected, and the "BC-projected" Hessian is
+ * P H P + (I - P), which is what every solver sees, assembled or matrix-free.
+ *
+ * Usage per Newton/L-BFGS iterate: problem_energy(dv) evaluates F, P and E
+ * at dv and caches them; problem_gradient() then scatters the cached stress;
+ * problem_tangent() computes the (projected) dP/dF per particle from the
+ * cached F, after which problem_assemble, problem_hessvec and
+ * problem_diagonal are available. */
+#ifndef MPM_PROBLEM_H
+#define MPM_PROBLEM_H
+
+#include <stddef.h>
+
+#include "core/bsr.h"
+#include "core/grid.h"
+#include "core/material.h"
+#include "core/particles.h"
+
+enum { BC_FREE = 0, BC_STICKY = 1, BC_SLIP = 2 };
+
+typedef struct StepProblem {
+    int n_nodes;
+    size_t n_particles;
+    double dt, dx, gravity[3];
+
+    /* borrowed, valid for one step */
+    const Grid *grid;
+    const Stencils *st;
+    const Particles *parts;
+    const Material *mats;
+    int n_mats;
+
+    /* per step */
+    double *a;           /* 81 per particle: a_ip (27 x 3) */
+    double *mu, *lambda; /* per particle Lame parameters (material, times hardening) */
+    double *stiff;       /* per particle CN stiffness a_p */
+    unsigned char *bc;   /* per node BC_* */
+    double *bc_P;        /* 9 per node projector (read for BC_SLIP) */
+    double *dv0;         /* 3 per node initial guess (Dirichlet values at constrained nodes) */
+    double *kappa;       /* per node: 24 dx^2 dt abar_i (SPEC 4, without eps) */
+    double max_stiffness;/* max_p a_p this step */
+    int n_dirichlet;
+
+    /* iterate cache */
+    double *F, *P;       /* 9 per particle at the last problem_energy point */
+    double *A;           /* 81 per particle after problem_tangent */
+    int tangent_projected;
+    double elastic_energy;
+
+    /* Hessian sparsity (per step) */
+    int pattern_ready;
+    short *slot;         /* 125 per node: position of neighbour offset in the row, -1 absent */
+    uint64_t *rowmask;   /* 2 per node: neighbour offsets present */
+
+    /* scratch */
+    double *tmp;         /* 3 per node */
+    size_t cap_particles;
+    int cap_nodes;
+} StepProblem;
+
+/* Sets up the problem for a step: borrows the grid, stencils, particles and
+ * materials, computes a_ip, per-particle Lame parameters, the CN scales, and
+ * marks every node free (the step driver then marks Dirichlet nodes with
+ * problem_set_dirichlet). */
+int problem_prepare(StepProblem *pb, const Grid *g, const Stencils *st, const Particles *p,
+                    const Material *mats, int n_mats, double dt, const double gravity[3]);
+
+/* Constrains node i: sticky (normal == NULL) fixes dv_i = v_target - v_i^n;
+ * slip fixes the normal component only: P_i = I - n n^T. Several slip calls
+ * on one node are combined (normals Gram-Schmidt'ed); sticky wins. */
+void problem_set_dirichlet(StepProblem *pb, int node, const double v_target[3], const double normal[3]);
+/* Counts the constrained nodes; call once after the last problem_set_dirichlet
+ * (problem_set_dirichlet touches only its node, so callers may run it in
+ * parallel over nodes). */
+void problem_finish_dirichlet(StepProblem *pb);
+
+/* Initial guess (HOT reference §1.3): free part dt g, constrained part fixed. */
+void problem_initial_guess(const StepProblem *pb, double *dv);
+
+/* Projects a vector onto the free subspace (zero at sticky nodes, tangential
+ * at slip nodes). */
+void problem_project(const StepProblem *pb, double *v);
+
+/* E(dv); caches F_p and P_p at dv. */
+double problem_energy(StepProblem *pb, const double *dv);
+
+/* Projected gradient at the point of the last problem_energy call. */
+void problem_gradient(StepProblem *pb, const double *dv, double *g);
+
+/* dP/dF per particle at the cached F (projected to SPD when asked). */
+int problem_tangent(StepProblem *pb, int projected);
+
+/* Assembles the BC-projected Hessian into H (pattern built once per step,
+ * storage reused). Requires problem_tangent. */
+int problem_assemble(StepProblem *pb, Bsr *H);
+
+/* y = (P H P + I - P) x, matrix-free (SPEC 3). Requires problem_tangent. */
+void problem_hessvec(StepProblem *pb, const double *x, double *y);
+
+/* Diagonal 3x3 blocks of the BC-projected Hessian (9 per node). */
+void problem_diagonal(StepProblem *pb, double *D);
+
+/* Scaled CN residual s = sqrt(1/n sum_i |g_i|^2 / kappa_i^2) (SPEC 4). The
+ * stopping rule of every solver is s < eps. */
+double problem_cn_residual(const StepProblem *pb, const double *g);
+
+/* Inexact-solve floor tau = eps dt 24 sqrt(n) dx^2 max_p a_p (SPEC 4). */
+double problem_tau(const StepProblem *pb, double eps);
+
+void problem_free(StepProblem *pb);
+
+#endif

@@ -1,0 +1,88 @@
+#include "core/transfer.h"
+
+#include <string.h>
+
+#include "core/mat3.h"
+
+void transfer_p2g(Grid *g, const Stencils *st, const Particles *p)
+{
+    int n = g->n;
+    double dx = g->dx;
+    memset(g->mass, 0, sizeof(double) * (size_t)n);
+    memset(g->v, 0, sizeof(double) * 3 * (size_t)n);
+    const NodeColoring *pc = &st->pcolor;
+    for (int c = 0; c < MPM_NUM_COLORS; ++c) {
+#pragma omp parallel for schedule(dynamic, 4)
+        for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
+            int q = pc->color_blocks[qi];
+            for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
+                const double *xp = p->x + 3 * (size_t)k, *vp = p->v + 3 * (size_t)k, *Cp = p->C + 9 * (size_t)k;
+                const int *base = st->base + 3 * (size_t)k;
+                const int *node = st->node + MPM_STENCIL * (size_t)k;
+                const double *w = st->w + MPM_STENCIL * (size_t)k;
+                double mp = p->mass[k];
+                for (int s = 0; s < MPM_STENCIL; ++s) {
+                    int i = node[s];
+                    if (i < 0) continue;
+                    double r[3] = {(base[0] + s / 9) * dx - xp[0], (base[1] + (s / 3) % 3) * dx - xp[1],
+                                   (base[2] + s % 3) * dx - xp[2]};
+                    double u[3];
+                    m3_mulv(Cp, r, u);
+                    double wm = w[s] * mp;
+                    g->mass[i] += wm;
+                    g->v[3 * i] += wm * (vp[0] + u[0]);
+                    g->v[3 * i + 1] += wm * (vp[1] + u[1]);
+                    g->v[3 * i + 2] += wm * (vp[2] + u[2]);
+                }
+            }
+        }
+    }
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < n; ++i) {
+        double inv = 1.0 / g->mass[i]; /* active nodes have positive mass by construction */
+        g->v[3 * i] *= inv;
+        g->v[3 * i + 1] *= inv;
+        g->v[3 * i + 2] *= inv;
+    }
+}
+
+void transfer_g2p(const Grid *g, const Stencils *st, Particles *p, const double *vnew, double dt,
+                  double apic_ratio)
+{
+    double dx = g->dx, dinv = 4.0 / (dx * dx);
+    double sym = 0.5 * (apic_ratio + 1.0), skew = 0.5 * (apic_ratio - 1.0);
+#pragma omp parallel for schedule(static)
+    for (size_t k = 0; k < p->n; ++k) {
+        double *xp = p->x + 3 * k;
+        const int *base = st->base + 3 * k;
+        const int *node = st->node + MPM_STENCIL * k;
+        const double *w = st->w + MPM_STENCIL * k, *dw = st->dw + 3 * MPM_STENCIL * k;
+        double v[3] = {0, 0, 0}, B[9] = {0}, G[9] = {0};
+        for (int s = 0; s < MPM_STENCIL; ++s) {
+            int i = node[s];
+            if (i < 0) continue;
+            const double *vi = vnew + 3 * (size_t)i;
+            double r[3] = {(base[0] + s / 9) * dx - xp[0], (base[1] + (s / 3) % 3) * dx - xp[1],
+                           (base[2] + s % 3) * dx - xp[2]};
+            for (int a = 0; a < 3; ++a) {
+                v[a] += w[s] * vi[a];
+                for (int b = 0; b < 3; ++b) {
+                    B[3 * a + b] += w[s] * vi[a] * r[b];
+                    G[3 * a + b] += vi[a] * dw[3 * s + b];
+                }
+            }
+        }
+        double *C = p->C + 9 * k;
+        for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b) C[3 * a + b] = dinv * (sym * B[3 * a + b] + skew * B[3 * b + a]);
+        memcpy(p->v + 3 * k, v, sizeof v);
+        for (int d = 0; d < 3; ++d) xp[d] += dt * v[d];
+        double Fn[9], L[9];
+        m3_copy(Fn, p->F + 9 * k);
+        for (int e = 0; e < 9; ++e) L[e] = dt * G[e];
+        L[0] += 1.0;
+        L[4] += 1.0;
+        L[8] += 1.0;
+        m3_mul(L, Fn, p->F + 9 * k);
+    }
+}

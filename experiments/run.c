@@ -1,0 +1,220 @@
+#include "experiments/run.h"
+
+#include <errno.h>
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "core/error.h"
+#include "core/step.h"
+#include "experiments/ply.h"
+#include "experiments/progress.h"
+#include "experiments/registry.h"
+#include "solvers/solver.h"
+
+void run_config_default(RunConfig *c)
+{
+    memset(c, 0, sizeof *c);
+    c->eps = 1e-7;
+    c->scale = 1.0;
+}
+
+static int mkdir_p(const char *path)
+{
+    char buf[1024];
+    if (snprintf(buf, sizeof buf, "%s", path) >= (int)sizeof buf) return mpm_error(MPM_EINPUT, "%s: path too long", path);
+    for (char *s = buf + 1; *s; ++s) {
+        if (*s != '/') continue;
+        *s = '\0';
+        if (mkdir(buf, 0755) != 0 && errno != EEXIST) return mpm_error(MPM_EINPUT, "%s: cannot create directory", buf);
+        *s = '/';
+    }
+    if (mkdir(buf, 0755) != 0 && errno != EEXIST) return mpm_error(MPM_EINPUT, "%s: cannot create directory", buf);
+    return MPM_OK;
+}
+
+static FILE *open_in(const char *dir, const char *name, int *status)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "w");
+    if (!f) *status = mpm_error(MPM_EINPUT, "%s: cannot write", path);
+    return f;
+}
+
+typedef struct {
+    FILE *iters;
+    Progress *progress;
+    int frame, step;
+    double fraction;
+} HookCtx;
+
+static void iter_hook(void *ctx, int iter, double elapsed, double residual, double energy)
+{
+    HookCtx *h = ctx;
+    if (h->iters)
+        fprintf(h->iters, "%d,%d,%d,%.6e,%.9e,%.12e\n", h->frame, h->step, iter, elapsed, residual, energy);
+    progress_update(h->progress, h->fraction, h->frame, h->step, iter, residual);
+}
+
+/* Records the exact configuration beside the tables, so every number says
+ * how it was made. */
+static void write_run_json(const char *dir, const RunConfig *cfg, const Scene *sc, const SolverOptions *so,
+                           int frames, int threads, int *status)
+{
+    FILE *f = open_in(dir, "run.json", status);
+    if (!f) return;
+    fprintf(f, "{\n  \"scene\": \"%s\",\n  \"scene_path\": \"%s\",\n  \"solver\": \"%s\",\n", sc->name, sc->path,
+            cfg->solver);
+    fprintf(f, "  \"solver_options\": {");
+    for (int i = 0; i < so->n; ++i) fprintf(f, "%s\"%s\": \"%s\"", i ? ", " : "", so->key[i], so->value[i]);
+    fprintf(f, "},\n  \"overrides\": {");
+    for (int i = 0; i < cfg->n_overrides; ++i)
+        fprintf(f, "%s\"%s\": \"%s\"", i ? ", " : "", cfg->overrides[i].key, cfg->overrides[i].value);
+    fprintf(f, "},\n  \"eps\": %.3e,\n  \"scale\": %g,\n  \"dx\": %.9g,\n  \"frames\": %d,\n  \"threads\": %d,\n",
+            cfg->eps, cfg->scale, sc->dx, frames, threads);
+    fprintf(f, "  \"line_search\": \"%s\",\n  \"particles\": %zu\n}\n", cfg->armijo ? "armijo" : "decrease",
+            sc->particles.n);
+    fclose(f);
+}
+
+static int worse(int a, int b) { return a > b ? a : b; } /* SolveStatus is ordered by severity */
+
+int run_simulation(const RunConfig *cfg, RunSummary *sum)
+{
+    int status = MPM_OK;
+    memset(sum, 0, sizeof *sum);
+    const SolverPreset *preset = registry_find(cfg->solver);
+    if (!preset) return mpm_error(MPM_EINPUT, "unknown solver '%s' (see: mpmbench list solvers)", cfg->solver);
+    if (!(cfg->eps > 0.0) || !isfinite(cfg->eps)) return mpm_error(MPM_EINPUT, "--eps %g: expected a positive number", cfg->eps);
+    if (!(cfg->scale > 0.0) || !isfinite(cfg->scale)) return mpm_error(MPM_EINPUT, "--scale %g: expected a positive number", cfg->scale);
+    SolverOptions so;
+    if ((status = registry_options(preset, cfg->solver_opts, cfg->n_solver_opts, &so))) return status;
+    if (cfg->threads > 0) omp_set_num_threads(cfg->threads);
+    int threads = omp_get_max_threads();
+
+    Scene scene;
+    SceneLoadOptions lo = {cfg->scale, cfg->overrides, cfg->n_overrides, cfg->asset_dir};
+    if ((status = scene_load(cfg->scene, &lo, &scene))) return status;
+    int frames = cfg->frames > 0 ? cfg->frames : scene.frames;
+
+    char out_dir[1024];
+    if (cfg->out_dir) snprintf(out_dir, sizeof out_dir, "%s", cfg->out_dir);
+    else snprintf(out_dir, sizeof out_dir, "out/%s-%s", scene.name, preset->name);
+    Solver *solver = NULL;
+    Simulation sim;
+    memset(&sim, 0, sizeof sim);
+    FILE *steps_csv = NULL, *frames_csv = NULL, *iters_csv = NULL;
+    double *dv = NULL;
+    int cap = 0;
+    if ((status = mkdir_p(out_dir))) goto done;
+    if (cfg->particles_dir && (status = mkdir_p(cfg->particles_dir))) goto done;
+    if ((status = solver_create(preset, &so, &solver))) goto done;
+    if (!(steps_csv = open_in(out_dir, "steps.csv", &status))) goto done;
+    if (!(frames_csv = open_in(out_dir, "frames.csv", &status))) goto done;
+    if (cfg->history && !(iters_csv = open_in(out_dir, "iters.csv", &status))) goto done;
+    write_run_json(out_dir, cfg, &scene, &so, frames, threads, &status);
+    if (status) goto done;
+    fprintf(steps_csv, "scene,solver,frame,step,t,dt,particles,active_nodes,hessian_blocks,outer_iters,linear_iters,"
+                       "ls_evals,residual,status,wall_s,p2g_s,assemble_s,setup_s,solve_s,linesearch_s,g2p_s,threads\n");
+    fprintf(frames_csv, "scene,solver,frame,steps,outer_iters,linear_iters,wall_s,max_residual,status,threads\n");
+    if (iters_csv) fprintf(iters_csv, "frame,step,iter,elapsed_s,residual,energy\n");
+
+    if ((status = sim_init(&sim, &scene))) goto done;
+    sum->particles = scene.particles.n;
+    sum->threads = threads;
+    Progress prog;
+    progress_init(&prog, frames);
+    SolveSettings set;
+    solve_settings_default(&set);
+    set.eps = cfg->eps;
+    set.armijo = cfg->armijo;
+    if (!cfg->quiet) {
+        printf("scene %s (%zu particles, dx %.4g m), solver %s, eps %.1e, %d threads\n", scene.name, scene.particles.n,
+               scene.dx, preset->name, cfg->eps, threads);
+        printf("%6s %6s %8s %9s %10s %12s  %s\n", "frame", "steps", "outer", "linear", "wall_s", "max_resid", "status");
+    }
+    HookCtx hook = {iters_csv, &prog, 0, 0, 0.0};
+    double run_t0 = omp_get_wtime();
+    while (sim.frame < frames) {
+        int frame = sim.frame, fsteps = 0, fstatus = SOLVE_CONVERGED;
+        long fouter = 0, flinear = 0;
+        double fwall = 0.0, fmaxres = 0.0;
+        while (sim.frame == frame) {
+            double t0 = omp_get_wtime();
+            if ((status = step_begin(&sim))) goto done;
+            double t1 = omp_get_wtime();
+            int n = sim.pb.n_nodes;
+            if (n > cap) {
+                cap = n + n / 4 + 256;
+                double *q = realloc(dv, sizeof(double) * 3 * (size_t)cap);
+                if (!q) {
+                    status = mpm_error(MPM_EINTERNAL, "out of memory: dv");
+                    goto done;
+                }
+                dv = q;
+            }
+            problem_initial_guess(&sim.pb, dv);
+            hook.frame = frame;
+            hook.step = fsteps;
+            hook.fraction = (frame + sim.t_in_frame / sim.frame_dt) / frames;
+            SolveStats ss;
+            if ((status = solver_solve(solver, &sim.pb, &set, dv, &ss, iter_hook, &hook))) goto done;
+            double t2 = omp_get_wtime();
+            double t_step = sim.t, dt = sim.dt;
+            int active = n;
+            if ((status = step_end(&sim, dv))) goto done;
+            double t3 = omp_get_wtime();
+            double wall = t3 - t0;
+            fprintf(steps_csv, "%s,%s,%d,%d,%.9g,%.9g,%zu,%d,%lld,%d,%ld,%d,%.6e,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d\n",
+                    scene.name, preset->name, frame, fsteps, t_step, dt, sim.p.n, active, (long long)ss.hessian_blocks,
+                    ss.outer_iters, ss.linear_iters, ss.ls_evals, ss.residual, solve_status_name(ss.status), wall,
+                    t1 - t0, ss.assemble_s, ss.setup_s, ss.solve_s, ss.linesearch_s, t3 - t2, threads);
+            fsteps++;
+            fouter += ss.outer_iters;
+            flinear += ss.linear_iters;
+            fwall += wall;
+            if (ss.residual > fmaxres) fmaxres = ss.residual;
+            fstatus = worse(fstatus, ss.status);
+        }
+        fprintf(frames_csv, "%s,%s,%d,%d,%ld,%ld,%.6f,%.6e,%s,%d\n", scene.name, preset->name, frame, fsteps, fouter,
+                flinear, fwall, fmaxres, solve_status_name(fstatus), threads);
+        fflush(steps_csv);
+        fflush(frames_csv);
+        progress_clear(&prog);
+        if (!cfg->quiet)
+            printf("%6d %6d %8ld %9ld %10.3f %12.3e  %s\n", frame, fsteps, fouter, flinear, fwall, fmaxres,
+                   solve_status_name(fstatus));
+        fflush(stdout);
+        if (cfg->particles_dir) {
+            char path[1200];
+            snprintf(path, sizeof path, "%s/frame_%04d.ply", cfg->particles_dir, frame + 1);
+            if ((status = ply_write_particles(path, &sim.p))) goto done;
+        }
+        sum->frames++;
+        sum->steps += fsteps;
+        sum->outer_iters += fouter;
+        sum->linear_iters += flinear;
+        if (fmaxres > sum->max_residual) sum->max_residual = fmaxres;
+        sum->worst_status = worse(sum->worst_status, fstatus);
+    }
+    sum->wall_s = omp_get_wtime() - run_t0;
+    if (!cfg->quiet) {
+        printf("total: %d frames, %d steps, %ld outer, %ld linear iterations, %.3f s wall (%.3f s/frame), worst status %s\n",
+               sum->frames, sum->steps, sum->outer_iters, sum->linear_iters, sum->wall_s,
+               sum->frames ? sum->wall_s / sum->frames : 0.0, solve_status_name((SolveStatus)sum->worst_status));
+        printf("wrote %s/steps.csv and %s/frames.csv%s\n", out_dir, out_dir, iters_csv ? " and iters.csv" : "");
+    }
+done:
+    if (steps_csv) fclose(steps_csv);
+    if (frames_csv) fclose(frames_csv);
+    if (iters_csv) fclose(iters_csv);
+    free(dv);
+    sim_free(&sim);
+    solver_destroy(solver);
+    scene_free(&scene);
+    return status;
+}
