@@ -5,6 +5,7 @@
 
 #include "core/error.h"
 #include "solvers/jacobi.h"
+#include "solvers/pcg_inverse.h"
 #include "solvers/sgs.h"
 
 static const SolverPreset g_presets[] = {
@@ -16,6 +17,8 @@ static const SolverPreset g_presets[] = {
      &inv_block_jacobi_ops, 1, ""},
     {"pn-sgs-pcg", "projected Newton, PCG preconditioned by one coloured symmetric block Gauss-Seidel sweep (HOT Table 3)",
      METHOD_PN, &inv_sgs_ops, 0, ""},
+    {"lbfgs-h", "L-BFGS, initial inverse = inexact block-Jacobi PCG on the start-of-step Hessian (HOT LBFGS-H)",
+     METHOD_LBFGS, &inv_inexact_pcg_ops, 0, ""},
 };
 
 int registry_count(void) { return (int)(sizeof g_presets / sizeof g_presets[0]); }

@@ -38,8 +38,9 @@ int solver_create(const SolverPreset *preset, const SolverOptions *opts, Solver 
         return status;
     }
     if (s->window < 1 || s->window > 64) {
+        int w = s->window;
         free(s);
-        return mpm_error(MPM_EINPUT, "--solver-opt window=%d: expected 1..64", s->window);
+        return mpm_error(MPM_EINPUT, "--solver-opt window=%d: expected 1..64", w);
     }
     if (preset->inv && (status = preset->inv->create(&s->opts, &s->inv))) {
         free(s);
@@ -127,6 +128,7 @@ int solver_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *d
     if (status) return status;
     switch (s->preset->method) {
     case METHOD_PN: return pn_solve(s, pb, set, dv, st, hook, hook_ctx);
+    case METHOD_LBFGS: return lbfgs_solve(s, pb, set, dv, st, hook, hook_ctx);
     default: return mpm_error(MPM_EINTERNAL, "solver %s: outer method not available", s->preset->name);
     }
 }

@@ -71,6 +71,9 @@ void solver_destroy(Solver *s);
 int pn_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv, SolveStats *st, IterHook hook,
              void *hook_ctx);
 
+int lbfgs_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv, SolveStats *st, IterHook hook,
+                void *hook_ctx);
+
 /* Shared by the outer methods: grows work vectors to n nodes. */
 int solver_reserve(Solver *s, int n_nodes);
 /* The BC-projected Hessian as a LinearOp (assembled or matrix-free). */

@@ -1,0 +1,265 @@
+/* Level-set colliders with piecewise-constant rigid motion (see collider.h).
+ *
+ * Rigid kinematics: with world-frame angular velocity omega and pivot
+ * p(t) = pivot0 + b(t), the pose R(t) obeys dR/dt = [omega]x R, whose exact
+ * solution over a phase of constant omega is R(t) = exp([omega]x tau) R0
+ * (Rodrigues' formula, m3_rotation); the material velocity at x is
+ * omega x (x - p(t)) + db/dt. */
+#include "core/collider.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "core/mat3.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+/* Index of the phase containing time t (phases cover [0, inf); t < 0 maps
+ * to the first). */
+static int find_phase(const Collider *c, double t)
+{
+    int k = 0;
+    while (k + 1 < c->n_phases && !(t < c->phases[k].t_end)) ++k;
+    return k;
+}
+
+static void pose_in_phase(const ColliderPhase *ph, double t, double R[9], double b[3])
+{
+    double tau = t - ph->t_start;
+    double w[3] = {ph->omega[0] * tau, ph->omega[1] * tau, ph->omega[2] * tau};
+    double E[9];
+    m3_rotation(w, E);
+    m3_mul(E, ph->R0, R);
+    for (int k = 0; k < 3; ++k) b[k] = ph->b0[k] + ph->vel[k] * tau;
+}
+
+void collider_pose(const Collider *c, double t, double R[9], double b[3])
+{
+    pose_in_phase(&c->phases[find_phase(c, t)], t, R, b);
+}
+
+int collider_active(const Collider *c, double t) { return !c->phases[find_phase(c, t)].removed; }
+
+/* Rest-frame point of world point x: X = R^T (x - pivot0 - b) + pivot0. */
+static void to_rest(const Collider *c, const double R[9], const double b[3], const double x[3], double X[3])
+{
+    double d[3] = {x[0] - c->pivot0[0] - b[0], x[1] - c->pivot0[1] - b[1], x[2] - c->pivot0[2] - b[2]};
+    for (int k = 0; k < 3; ++k) X[k] = R[k] * d[0] + R[3 + k] * d[1] + R[6 + k] * d[2] + c->pivot0[k];
+}
+
+double collider_phi(const Collider *c, double t, const double x[3], double normal[3])
+{
+    const ColliderPhase *ph = &c->phases[find_phase(c, t)];
+    if (ph->removed) {
+        if (normal) normal[0] = normal[1] = normal[2] = 0.0;
+        return HUGE_VAL;
+    }
+    double R[9], b[3], X[3];
+    pose_in_phase(ph, t, R, b);
+    to_rest(c, R, b, x, X);
+    double phi = shape_sdf(c->shape, X);
+    if (normal) {
+        double g[3], h = c->fd_h;
+        for (int k = 0; k < 3; ++k) {
+            double Xp[3] = {X[0], X[1], X[2]}, Xm[3] = {X[0], X[1], X[2]};
+            Xp[k] += h;
+            Xm[k] -= h;
+            g[k] = (shape_sdf(c->shape, Xp) - shape_sdf(c->shape, Xm)) / (2.0 * h);
+        }
+        double n[3];
+        m3_mulv(R, g, n);
+        double len = v3_norm(n);
+        if (len > 0 && isfinite(len))
+            for (int k = 0; k < 3; ++k) normal[k] = n[k] / len;
+        else
+            normal[0] = normal[1] = normal[2] = 0.0;
+    }
+    return phi;
+}
+
+static void velocity_in_phase(const Collider *c, const ColliderPhase *ph, double t, const double x[3],
+                              double v[3])
+{
+    if (ph->removed) {
+        v[0] = v[1] = v[2] = 0.0;
+        return;
+    }
+    double tau = t - ph->t_start;
+    double r[3], wr[3];
+    for (int k = 0; k < 3; ++k) r[k] = x[k] - (c->pivot0[k] + ph->b0[k] + ph->vel[k] * tau);
+    v3_cross(ph->omega, r, wr);
+    for (int k = 0; k < 3; ++k) v[k] = wr[k] + ph->vel[k];
+}
+
+void collider_velocity(const Collider *c, double t, const double x[3], double v[3])
+{
+    velocity_in_phase(c, &c->phases[find_phase(c, t)], t, x, v);
+}
+
+double collider_max_speed(const Collider *c, double t, const double lo[3], const double hi[3])
+{
+    const ColliderPhase *ph = &c->phases[find_phase(c, t)];
+    if (ph->removed) return 0.0;
+    /* Current world bounds of the collider: the rest bounds' corners posed. */
+    double slo[3], shi[3], blo[3], bhi[3];
+    shape_bounds(c->shape, slo, shi);
+    int bounded = shape_is_bounded(c->shape);
+    double box_lo[3], box_hi[3];
+    memcpy(box_lo, lo, sizeof box_lo);
+    memcpy(box_hi, hi, sizeof box_hi);
+    if (bounded) {
+        double R[9], b[3];
+        pose_in_phase(ph, t, R, b);
+        for (int k = 0; k < 3; ++k) blo[k] = HUGE_VAL, bhi[k] = -HUGE_VAL;
+        for (int corner = 0; corner < 8; ++corner) {
+            double X[3], d[3], w[3];
+            for (int k = 0; k < 3; ++k) X[k] = (corner >> k) & 1 ? shi[k] : slo[k];
+            for (int k = 0; k < 3; ++k) d[k] = X[k] - c->pivot0[k];
+            m3_mulv(R, d, w);
+            for (int k = 0; k < 3; ++k) {
+                double xw = w[k] + c->pivot0[k] + b[k];
+                blo[k] = fmin(blo[k], xw);
+                bhi[k] = fmax(bhi[k], xw);
+            }
+        }
+        int overlap = 1;
+        double ilo[3], ihi[3];
+        for (int k = 0; k < 3; ++k) {
+            ilo[k] = fmax(lo[k], blo[k]);
+            ihi[k] = fmin(hi[k], bhi[k]);
+            if (ilo[k] > ihi[k]) overlap = 0;
+        }
+        if (overlap) {
+            memcpy(box_lo, ilo, sizeof ilo);
+            memcpy(box_hi, ihi, sizeof ihi);
+        }
+    }
+    double vmax = 0.0;
+    for (int corner = 0; corner < 8; ++corner) {
+        double x[3], v[3];
+        for (int k = 0; k < 3; ++k) x[k] = (corner >> k) & 1 ? box_hi[k] : box_lo[k];
+        velocity_in_phase(c, ph, t, x, v);
+        double s = v3_norm(v);
+        if (s > vmax) vmax = s;
+    }
+    return vmax;
+}
+
+void collider_free(Collider *c)
+{
+    if (!c) return;
+    shape_free(c->shape);
+    free(c->phases);
+    memset(c, 0, sizeof *c);
+}
+
+static int parse_phase(json_t *j, const char *file, const char *path, int is_last, double t_start,
+                       ColliderPhase *ph)
+{
+    static const char *const keys[] = {"until", "velocity", "angular_velocity_deg", "removed", NULL};
+    int st = sj_check_object(j, file, path, keys);
+    if (st) return st;
+    json_t *u = json_object_get(j, "until");
+    ph->t_start = t_start;
+    ph->t_end = HUGE_VAL;
+    if (u && !json_is_null(u)) {
+        if ((st = sj_number(j, "until", 1, file, path, &ph->t_end, NULL))) return st;
+        if (!(ph->t_end > t_start)) {
+            char what[96];
+            snprintf(what, sizeof what, "expected a time after the phase start %.10g s", t_start);
+            return sj_bad_number(file, path, "until", what, ph->t_end);
+        }
+    } else if (!is_last) {
+        return sj_bad(file, path, "until", "expected a number (only the last phase may omit it)", u);
+    }
+    double deg[3] = {0, 0, 0};
+    if ((st = sj_vec3(j, "velocity", 0, file, path, ph->vel, NULL))) return st;
+    if ((st = sj_vec3(j, "angular_velocity_deg", 0, file, path, deg, NULL))) return st;
+    for (int k = 0; k < 3; ++k) ph->omega[k] = deg[k] * (M_PI / 180.0);
+    if ((st = sj_bool(j, "removed", 0, file, path, &ph->removed, NULL))) return st;
+    return MPM_OK;
+}
+
+static int parse_motion(json_t *j, const char *file, const char *path, Collider *c)
+{
+    json_t *m = json_object_get(j, "motion");
+    size_t n = m ? json_array_size(m) : 0;
+    if (m && (!json_is_array(m) || n == 0))
+        return sj_bad(file, path, "motion", "expected a non-empty array of motion phases", m);
+    /* One spare slot for the implicit rest phase after a final "until". */
+    c->phases = calloc(n + 1, sizeof *c->phases);
+    if (!c->phases) return mpm_error(MPM_EINTERNAL, "out of memory parsing a collider");
+    char base[512], p[512];
+    sj_path(base, sizeof base, path, "motion");
+    double t = 0.0;
+    for (size_t k = 0; k < n; ++k) {
+        sj_path_index(p, sizeof p, base, k);
+        int st = parse_phase(json_array_get(m, k), file, p, k + 1 == n, t, &c->phases[k]);
+        if (st) return st;
+        t = c->phases[k].t_end;
+    }
+    c->n_phases = (int)n;
+    if (n == 0 || isfinite(t)) {
+        ColliderPhase *rest = &c->phases[c->n_phases++];
+        rest->t_start = t;
+        rest->t_end = HUGE_VAL;
+    }
+    /* Precompute each phase's starting pose. */
+    m3_identity(c->phases[0].R0);
+    for (int k = 0; k + 1 < c->n_phases; ++k) {
+        ColliderPhase *a = &c->phases[k], *b = &c->phases[k + 1];
+        pose_in_phase(a, a->t_end, b->R0, b->b0);
+    }
+    return MPM_OK;
+}
+
+int collider_parse_named(json_t *j, const char *file, const char *jpath, const char *asset_dir, double dx,
+                         const char *default_name, Collider *out)
+{
+    static const char *const keys[] = {"name", "type", "shape", "pivot", "motion", NULL};
+    Collider c;
+    memset(&c, 0, sizeof c);
+    memset(out, 0, sizeof *out);
+    int st = sj_check_object(j, file, jpath, keys);
+    if (st) return st;
+    const char *name = default_name ? default_name : "collider", *type = "sticky";
+    if ((st = sj_string(j, "name", 0, file, jpath, &name, NULL))) return st;
+    if (strlen(name) == 0 || strlen(name) >= sizeof c.name)
+        return sj_bad(file, jpath, "name", "expected a name of 1 to 63 characters", json_object_get(j, "name"));
+    memcpy(c.name, name, strlen(name) + 1);
+    if ((st = sj_string(j, "type", 0, file, jpath, &type, NULL))) return st;
+    if (strcmp(type, "sticky") == 0)
+        c.kind = COLLIDER_STICKY;
+    else if (strcmp(type, "slip") == 0)
+        c.kind = COLLIDER_SLIP;
+    else
+        return sj_bad(file, jpath, "type", "expected \"sticky\" or \"slip\"", json_object_get(j, "type"));
+    json_t *sh = json_object_get(j, "shape");
+    char p[512];
+    sj_path(p, sizeof p, jpath, "shape");
+    if (!sh) return mpm_error(MPM_EINPUT, "%s: %s: missing required field", file, p);
+    if ((st = shape_parse(sh, file, p, asset_dir, dx, &c.shape))) return st;
+    /* pivot: explicit, else the bounds centre (finite axes only) */
+    double lo[3], hi[3];
+    shape_bounds(c.shape, lo, hi);
+    for (int k = 0; k < 3; ++k) c.pivot0[k] = (isfinite(lo[k]) && isfinite(hi[k])) ? 0.5 * (lo[k] + hi[k]) : 0.0;
+    if ((st = sj_vec3(j, "pivot", 0, file, jpath, c.pivot0, NULL)) ||
+        (st = parse_motion(j, file, jpath, &c))) {
+        collider_free(&c);
+        return st;
+    }
+    c.fd_h = dx > 0 && isfinite(dx) ? 1e-3 * dx : 1e-6;
+    *out = c;
+    return MPM_OK;
+}
+
+int collider_parse(json_t *j, const char *file, const char *jpath, const char *asset_dir, double dx,
+                   Collider *out)
+{
+    return collider_parse_named(j, file, jpath, asset_dir, dx, NULL, out);
+}

@@ -1,0 +1,738 @@
+/* Scene loading and validation (format in scene.h). */
+#ifndef _POSIX_C_SOURCE
+#define _POSIX_C_SOURCE 200809L
+#endif
+#include "core/scene.h"
+
+#include <dirent.h>
+#include <jansson.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "core/error.h"
+#include "core/rng.h"
+#include "core/sampler.h"
+
+#ifndef MPM_SCENE_DIR
+#define MPM_SCENE_DIR "experiments/scenes"
+#endif
+
+const char *scene_dir(void)
+{
+    const char *d = getenv("MPM_SCENE_DIR");
+    return (d && d[0]) ? d : MPM_SCENE_DIR;
+}
+
+static int is_builtin_name(const char *s)
+{
+    size_t n = strlen(s);
+    if (strchr(s, '/')) return 0;
+    if (n >= 5 && strcmp(s + n - 5, ".json") == 0) return 0;
+    return 1;
+}
+
+static int file_exists(const char *p)
+{
+    struct stat st;
+    return stat(p, &st) == 0 && S_ISREG(st.st_mode);
+}
+
+/* ======================================================================
+ * Listing built-ins
+ * ====================================================================== */
+
+static int cmp_str(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
+
+/* Sorted built-in names (without .json); caller frees each and the array. */
+static int list_names(char ***names_out, int *n_out)
+{
+    *names_out = NULL;
+    *n_out = 0;
+    DIR *d = opendir(scene_dir());
+    if (!d) return mpm_error(MPM_EINPUT, "cannot open the scene directory %s (set MPM_SCENE_DIR)", scene_dir());
+    char **names = NULL;
+    int n = 0, cap = 0;
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        size_t len = strlen(e->d_name);
+        if (len <= 5 || strcmp(e->d_name + len - 5, ".json") != 0 || e->d_name[0] == '.') continue;
+        if (n == cap) {
+            cap = cap ? 2 * cap : 16;
+            char **q = realloc(names, (size_t)cap * sizeof *q);
+            if (!q) break;
+            names = q;
+        }
+        names[n] = malloc(len - 4);
+        if (!names[n]) break;
+        memcpy(names[n], e->d_name, len - 5);
+        names[n][len - 5] = '\0';
+        ++n;
+    }
+    closedir(d);
+    qsort(names, (size_t)n, sizeof *names, cmp_str);
+    *names_out = names;
+    *n_out = n;
+    return MPM_OK;
+}
+
+static void free_names(char **names, int n)
+{
+    for (int k = 0; k < n; ++k) free(names[k]);
+    free(names);
+}
+
+int scene_list(SceneListFn fn, void *ctx)
+{
+    char **names;
+    int n;
+    int st = list_names(&names, &n);
+    if (st) return st;
+    for (int k = 0; k < n; ++k) {
+        char path[2048];
+        snprintf(path, sizeof path, "%s/%s.json", scene_dir(), names[k]);
+        json_error_t err;
+        json_t *root = json_load_file(path, 0, &err);
+        const char *desc = "(unreadable scene file)";
+        json_t *dj = root ? json_object_get(root, "description") : NULL;
+        if (root) desc = json_is_string(dj) ? json_string_value(dj) : "";
+        fn(names[k], desc, ctx);
+        json_decref(root);
+    }
+    free_names(names, n);
+    return MPM_OK;
+}
+
+/* ======================================================================
+ * Overrides
+ * ====================================================================== */
+
+/* Optional fields that --set may create when absent, by context. */
+static const char *const k_top_optional[] = {"description", "cfl",  "max_dt", "apic_ratio",
+                                             "domain_walls", "seed", "colliders", NULL};
+static const char *const k_mat_optional[] = {"plasticity", NULL};
+static const char *const k_plast_optional[] = {"yield_stress", "theta_c", "theta_s", "hardening",
+                                               "min_Jp",       "max_Jp",  NULL};
+static const char *const k_obj_optional[] = {"name", "sampling", "velocity", "initial_F", NULL};
+static const char *const k_col_optional[] = {"name", "type", "pivot", "motion", NULL};
+
+static int in_list(const char *const *list, const char *s)
+{
+    for (; *list; ++list)
+        if (strcmp(*list, s) == 0) return 1;
+    return 0;
+}
+
+static int all_digits(const char *s)
+{
+    if (!*s) return 0;
+    for (; *s; ++s)
+        if (*s < '0' || *s > '9') return 0;
+    return 1;
+}
+
+static int apply_override(json_t *root, const char *file, const SceneOverride *o)
+{
+    if (!o->key || !o->key[0] || !o->value)
+        return mpm_error(MPM_EINPUT, "%s: --set: expected key=value", file);
+    char key[512];
+    if (strlen(o->key) >= sizeof key) return mpm_error(MPM_EINPUT, "%s: --set %s: key too long", file, o->key);
+    strcpy(key, o->key);
+    /* split into tokens */
+    char *tok[64];
+    int nt = 0;
+    for (char *p = key;;) {
+        if (nt == 64) return mpm_error(MPM_EINPUT, "%s: --set %s: path too deep", file, o->key);
+        tok[nt++] = p;
+        char *dot = strchr(p, '.');
+        if (!dot) break;
+        *dot = '\0';
+        p = dot + 1;
+    }
+    for (int k = 0; k < nt; ++k)
+        if (!tok[k][0]) return mpm_error(MPM_EINPUT, "%s: --set %s: empty path component", file, o->key);
+    json_t *cur = root;
+    char path[512] = "";
+    for (int k = 0; k + 1 < nt; ++k) {
+        json_t *next = NULL;
+        if (json_is_object(cur))
+            next = json_object_get(cur, tok[k]);
+        else if (json_is_array(cur) && all_digits(tok[k]))
+            next = json_array_get(cur, (size_t)strtoull(tok[k], NULL, 10));
+        char np[512];
+        sj_path(np, sizeof np, path, tok[k]);
+        if (!next)
+            return mpm_error(MPM_EINPUT, "%s: --set %s: %s does not exist%s", file, o->key, np,
+                             json_is_array(cur) ? " (array index out of range)" : "");
+        strcpy(path, np);
+        cur = next;
+    }
+    json_error_t err;
+    json_t *val = json_loads(o->value, JSON_DECODE_ANY, &err);
+    if (!val) val = json_string(o->value);
+    if (!val) return mpm_error(MPM_EINPUT, "%s: --set %s: value is not valid UTF-8", file, o->key);
+    const char *leaf = tok[nt - 1];
+    char lp[512];
+    sj_path(lp, sizeof lp, path, leaf);
+    if (json_is_object(cur)) {
+        if (!json_object_get(cur, leaf)) {
+            const char *const *opt = NULL;
+            if (nt == 1)
+                opt = k_top_optional;
+            else if (nt == 3 && strcmp(tok[0], "materials") == 0)
+                opt = k_mat_optional;
+            else if (nt == 4 && strcmp(tok[0], "materials") == 0 && strcmp(tok[2], "plasticity") == 0)
+                opt = k_plast_optional;
+            else if (nt == 3 && strcmp(tok[0], "objects") == 0)
+                opt = k_obj_optional;
+            else if (nt == 3 && strcmp(tok[0], "colliders") == 0)
+                opt = k_col_optional;
+            if (!opt || !in_list(opt, leaf)) {
+                json_decref(val);
+                return mpm_error(MPM_EINPUT, "%s: --set %s: %s does not exist", file, o->key, lp);
+            }
+        }
+        json_object_set_new(cur, leaf, val);
+        return MPM_OK;
+    }
+    if (json_is_array(cur) && all_digits(leaf)) {
+        size_t idx = (size_t)strtoull(leaf, NULL, 10);
+        if (idx < json_array_size(cur)) {
+            json_array_set_new(cur, idx, val);
+            return MPM_OK;
+        }
+    }
+    json_decref(val);
+    return mpm_error(MPM_EINPUT, "%s: --set %s: %s does not exist", file, o->key, lp);
+}
+
+/* ======================================================================
+ * Validation helpers
+ * ====================================================================== */
+
+static int read_name(json_t *obj, const char *key, int required, const char *file, const char *path,
+                     char *dst, size_t cap)
+{
+    const char *s = NULL;
+    int present = 0;
+    int st = sj_string(obj, key, required, file, path, &s, &present);
+    if (st || !present) return st;
+    if (strlen(s) == 0 || strlen(s) >= cap) {
+        char what[64];
+        snprintf(what, sizeof what, "expected a string of 1 to %zu characters", cap - 1);
+        return sj_bad(file, path, key, what, json_object_get(obj, key));
+    }
+    memcpy(dst, s, strlen(s) + 1);
+    return MPM_OK;
+}
+
+static int parse_material(json_t *j, const char *name, const char *file, const char *path, Material *m)
+{
+    static const char *const keys[] = {"E", "nu", "density", "plasticity", NULL};
+    int st = sj_check_object(j, file, path, keys);
+    if (st) return st;
+    memset(m, 0, sizeof *m);
+    if (strlen(name) == 0 || strlen(name) >= sizeof m->name)
+        return mpm_error(MPM_EINPUT, "%s: %s: material names must have 1 to 63 characters", file, path);
+    memcpy(m->name, name, strlen(name) + 1);
+    if ((st = sj_positive(j, "E", 1, file, path, &m->E, NULL))) return st;
+    if ((st = sj_number(j, "nu", 1, file, path, &m->nu, NULL))) return st;
+    if (!(m->nu > -1.0 && m->nu < 0.5))
+        return sj_bad_number(file, path, "nu", "expected a Poisson ratio in (-1, 0.5)", m->nu);
+    if ((st = sj_positive(j, "density", 1, file, path, &m->density, NULL))) return st;
+    m->plasticity = PLASTICITY_NONE;
+    m->min_Jp = 0.0;
+    m->max_Jp = 1e30;
+    json_t *pj = json_object_get(j, "plasticity");
+    if (pj) {
+        char pp[512];
+        sj_path(pp, sizeof pp, path, "plasticity");
+        static const char *const pkeys[] = {"type",    "yield_stress", "theta_c", "theta_s",
+                                            "hardening", "min_Jp",     "max_Jp",  NULL};
+        if ((st = sj_check_object(pj, file, pp, pkeys))) return st;
+        const char *type = NULL;
+        if ((st = sj_string(pj, "type", 1, file, pp, &type, NULL))) return st;
+        if (strcmp(type, "none") == 0) {
+            static const char *const nk[] = {"type", NULL};
+            if ((st = sj_check_object(pj, file, pp, nk))) return st;
+        } else if (strcmp(type, "von_mises") == 0) {
+            static const char *const vk[] = {"type", "yield_stress", NULL};
+            if ((st = sj_check_object(pj, file, pp, vk))) return st;
+            m->plasticity = PLASTICITY_VON_MISES;
+            if ((st = sj_positive(pj, "yield_stress", 1, file, pp, &m->yield_stress, NULL))) return st;
+        } else if (strcmp(type, "snow") == 0) {
+            static const char *const sk[] = {"type", "theta_c", "theta_s", "hardening", "min_Jp", "max_Jp", NULL};
+            if ((st = sj_check_object(pj, file, pp, sk))) return st;
+            m->plasticity = PLASTICITY_SNOW;
+            if ((st = sj_number(pj, "theta_c", 1, file, pp, &m->theta_c, NULL))) return st;
+            if (!(m->theta_c > 0 && m->theta_c < 1))
+                return sj_bad_number(file, pp, "theta_c", "expected a number in (0, 1)", m->theta_c);
+            if ((st = sj_number(pj, "theta_s", 1, file, pp, &m->theta_s, NULL))) return st;
+            if (!(m->theta_s >= 0))
+                return sj_bad_number(file, pp, "theta_s", "expected a non-negative number", m->theta_s);
+            if ((st = sj_number(pj, "hardening", 0, file, pp, &m->hardening, NULL))) return st;
+            if (!(m->hardening >= 0))
+                return sj_bad_number(file, pp, "hardening", "expected a non-negative number", m->hardening);
+            if ((st = sj_number(pj, "min_Jp", 0, file, pp, &m->min_Jp, NULL))) return st;
+            if ((st = sj_number(pj, "max_Jp", 0, file, pp, &m->max_Jp, NULL))) return st;
+            if (!(m->max_Jp > m->min_Jp))
+                return sj_bad_number(file, pp, "max_Jp", "expected a number above min_Jp", m->max_Jp);
+        } else {
+            return sj_bad(file, pp, "type", "expected \"none\", \"von_mises\" or \"snow\"",
+                          json_object_get(pj, "type"));
+        }
+    }
+    material_derive(m);
+    if (!isfinite(m->mu) || !isfinite(m->lambda) || !isfinite(m->stiffness)) {
+        char p[512];
+        sj_path(p, sizeof p, path, "E");
+        return mpm_error(MPM_EINPUT, "%s: %s: E = %.10g and nu = %.10g give non-finite Lame parameters", file, p, m->E,
+                         m->nu);
+    }
+    return MPM_OK;
+}
+
+typedef struct {
+    Shape *shape;
+    int mat;
+    double ppc;
+    SamplingKind sampling;
+    double velocity[3];
+    int has_F;
+    double F_min, F_max;
+    uint64_t F_seed;
+    int F_per_particle;
+} ObjectSpec;
+
+static int parse_initial_F(json_t *j, const char *file, const char *path, uint64_t default_seed,
+                           ObjectSpec *o)
+{
+    static const char *const keys[] = {"type", "min", "max", "seed", "per_particle", NULL};
+    int st = sj_check_object(j, file, path, keys);
+    if (st) return st;
+    const char *type = NULL;
+    if ((st = sj_string(j, "type", 1, file, path, &type, NULL))) return st;
+    if (strcmp(type, "random_diagonal") != 0)
+        return sj_bad(file, path, "type", "expected \"random_diagonal\"", json_object_get(j, "type"));
+    if ((st = sj_positive(j, "min", 1, file, path, &o->F_min, NULL))) return st;
+    if ((st = sj_number(j, "max", 1, file, path, &o->F_max, NULL))) return st;
+    if (!(o->F_max >= o->F_min)) return sj_bad_number(file, path, "max", "expected a number >= min", o->F_max);
+    o->F_seed = default_seed;
+    json_t *sj = json_object_get(j, "seed");
+    if (sj) {
+        if (!json_is_integer(sj) || json_integer_value(sj) < 0)
+            return sj_bad(file, path, "seed", "expected a non-negative integer", sj);
+        o->F_seed = (uint64_t)json_integer_value(sj);
+    }
+    o->F_per_particle = 1;
+    if ((st = sj_bool(j, "per_particle", 0, file, path, &o->F_per_particle, NULL))) return st;
+    o->has_F = 1;
+    return MPM_OK;
+}
+
+static int parse_object(json_t *j, const char *file, const char *path, uint64_t index, const Scene *sc,
+                        const char *asset_dir, ObjectSpec *o)
+{
+    static const char *const keys[] = {"name", "material", "shape", "ppc", "sampling", "velocity", "initial_F",
+                                       NULL};
+    int st = sj_check_object(j, file, path, keys);
+    if (st) return st;
+    const char *s = NULL;
+    char tmp[64];
+    if ((st = read_name(j, "name", 0, file, path, tmp, sizeof tmp))) return st;
+    if ((st = sj_string(j, "material", 1, file, path, &s, NULL))) return st;
+    o->mat = -1;
+    for (int k = 0; k < sc->n_materials; ++k)
+        if (strcmp(sc->materials[k].name, s) == 0) o->mat = k;
+    if (o->mat < 0) {
+        char list[512] = "";
+        size_t used = 0;
+        for (int k = 0; k < sc->n_materials && used + 70 < sizeof list; ++k) {
+            int w = snprintf(list + used, sizeof list - used, "%s%s", k ? ", " : "", sc->materials[k].name);
+            if (w > 0) used += (size_t)w;
+        }
+        char p[512];
+        sj_path(p, sizeof p, path, "material");
+        return mpm_error(MPM_EINPUT, "%s: %s: unknown material \"%s\" (defined: %s)", file, p, s, list);
+    }
+    json_t *sh = json_object_get(j, "shape");
+    char sp[512];
+    sj_path(sp, sizeof sp, path, "shape");
+    if (!sh) return mpm_error(MPM_EINPUT, "%s: %s: missing required field", file, sp);
+    if ((st = sj_positive(j, "ppc", 1, file, path, &o->ppc, NULL))) return st;
+    o->sampling = SAMPLING_POISSON;
+    const char *samp = NULL;
+    int have = 0;
+    if ((st = sj_string(j, "sampling", 0, file, path, &samp, &have))) return st;
+    if (have && !sampling_kind_from_string(samp, &o->sampling))
+        return sj_bad(file, path, "sampling", "expected \"poisson\", \"random\" or \"lattice\"",
+                      json_object_get(j, "sampling"));
+    if (o->sampling == SAMPLING_LATTICE) {
+        double k = round(cbrt(o->ppc));
+        if (fabs(k * k * k - o->ppc) > 1e-9 * o->ppc)
+            return sj_bad_number(file, path, "ppc", "expected a cube k^3 (1, 8, 27, ...) for lattice sampling",
+                                 o->ppc);
+    }
+    if ((st = sj_vec3(j, "velocity", 0, file, path, o->velocity, NULL))) return st;
+    json_t *fj = json_object_get(j, "initial_F");
+    if (fj) {
+        char fp[512];
+        sj_path(fp, sizeof fp, path, "initial_F");
+        if ((st = parse_initial_F(fj, file, fp, rng_mix(sc->seed, 0xF000ull + index), o))) return st;
+    }
+    if ((st = shape_parse(sh, file, sp, asset_dir, sc->dx, &o->shape))) return st;
+    if (!shape_is_bounded(o->shape))
+        return mpm_error(MPM_EINPUT, "%s: %s: an object's shape must be bounded (got an unbounded %s)", file, sp,
+                         shape_type_name(o->shape));
+    double lo[3], hi[3];
+    shape_bounds(o->shape, lo, hi);
+    for (int d = 0; d < 3; ++d)
+        if (hi[d] < sc->domain_lo[d] || lo[d] > sc->domain_hi[d])
+            return mpm_error(MPM_EINPUT,
+                             "%s: %s: object bounds [%g, %g, %g]-[%g, %g, %g] lie outside the domain "
+                             "[%g, %g, %g]-[%g, %g, %g]",
+                             file, sp, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], sc->domain_lo[0], sc->domain_lo[1],
+                             sc->domain_lo[2], sc->domain_hi[0], sc->domain_hi[1], sc->domain_hi[2]);
+    return MPM_OK;
+}
+
+static int add_walls(Scene *sc, const char *file)
+{
+    static const char axes[3] = {'x', 'y', 'z'};
+    for (int d = 0; d < 3; ++d)
+        for (int side = 0; side < 2; ++side) {
+            double point[3] = {0, 0, 0}, normal[3] = {0, 0, 0};
+            point[d] = side ? sc->domain_hi[d] : sc->domain_lo[d];
+            normal[d] = side ? -1.0 : 1.0; /* outward normal of the wall solid points into the domain */
+            char name[32];
+            snprintf(name, sizeof name, "wall_%c_%s", axes[d], side ? "max" : "min");
+            json_t *j = json_pack("{s:s, s:s, s:{s:s, s:[f,f,f], s:[f,f,f]}}", "name", name, "type", "sticky",
+                                  "shape", "type", "half_space", "point", point[0], point[1], point[2],
+                                  "normal", normal[0], normal[1], normal[2]);
+            if (!j) return mpm_error(MPM_EINTERNAL, "out of memory building domain walls");
+            int st = collider_parse(j, file, "domain_walls", NULL, sc->dx, &sc->colliders[sc->n_colliders]);
+            json_decref(j);
+            if (st) return st;
+            ++sc->n_colliders;
+        }
+    return MPM_OK;
+}
+
+static int sample_objects(Scene *sc, const char *file, ObjectSpec *objs, int nobj)
+{
+    PoissonTile *own = NULL;
+    const PoissonTile *tile = NULL;
+    int st = MPM_OK;
+    for (int i = 0; i < nobj && !st; ++i)
+        if (objs[i].sampling == SAMPLING_POISSON) {
+            tile = poisson_tile_shared(sc->seed);
+            if (!tile) {
+                st = poisson_tile_create(sc->seed, &own);
+                tile = own;
+            }
+            break;
+        }
+    if (st) return st;
+    sc->object_offsets = calloc((size_t)nobj + 1, sizeof(size_t));
+    if (!sc->object_offsets) st = mpm_error(MPM_EINTERNAL, "out of memory");
+    sc->n_objects = nobj;
+    for (int i = 0; i < nobj && !st; ++i) {
+        ObjectSpec *o = &objs[i];
+        char path[64];
+        sj_path_index(path, sizeof path, "objects", (size_t)i);
+        SamplePoints pts;
+        memset(&pts, 0, sizeof pts);
+        st = sampler_sample(o->shape, o->sampling, sc->dx, o->ppc, rng_mix(sc->seed, 0x5A00ull + (uint64_t)i), tile,
+                            &pts);
+        if (st) {
+            /* re-issue the sampler's message with the place in the file */
+            char msg[900];
+            snprintf(msg, sizeof msg, "%s", mpm_last_error());
+            mpm_clear_error();
+            mpm_error(st, "%s: %s: %s", file, path, msg);
+            break;
+        }
+        if (pts.n == 0) {
+            sample_points_free(&pts);
+            st = mpm_error(MPM_EINPUT, "%s: %s: no particles sampled (shape smaller than the particle spacing at dx %g?)",
+                           file, path, sc->dx);
+            break;
+        }
+        double vol = shape_volume(o->shape);
+        double vp = vol / (double)pts.n, mass = sc->materials[o->mat].density * vp;
+        if (!(vp > 0) || !isfinite(vp) || !(mass > 0) || !isfinite(mass)) {
+            sample_points_free(&pts);
+            st = mpm_error(MPM_EINPUT, "%s: %s: particle volume %g and mass %g are not positive and finite", file,
+                           path, vp, mass);
+            break;
+        }
+        for (size_t k = 0; k < pts.n; ++k) {
+            const double *x = pts.x + 3 * k;
+            for (int d = 0; d < 3; ++d)
+                if (!(x[d] >= sc->domain_lo[d] && x[d] <= sc->domain_hi[d])) {
+                    st = mpm_error(MPM_EINPUT,
+                                   "%s: %s.shape: particle at (%g, %g, %g) lies outside the domain [%g, %g, %g]-[%g, "
+                                   "%g, %g]",
+                                   file, path, x[0], x[1], x[2], sc->domain_lo[0], sc->domain_lo[1],
+                                   sc->domain_lo[2], sc->domain_hi[0], sc->domain_hi[1], sc->domain_hi[2]);
+                    break;
+                }
+            if (st) break;
+        }
+        Particles *P = &sc->particles;
+        size_t first = P->n;
+        if (!st) st = particles_reserve(P, P->n + pts.n);
+        Rng rng;
+        double diag[3] = {1, 1, 1};
+        if (o->has_F) {
+            rng_seed(&rng, o->F_seed);
+            for (int d = 0; d < 3; ++d) diag[d] = rng_uniform(&rng, o->F_min, o->F_max);
+        }
+        for (size_t k = 0; k < pts.n && !st; ++k) {
+            st = particles_push(P, pts.x + 3 * k, o->velocity, mass, vp, o->mat);
+            if (st || !o->has_F) continue;
+            if (o->F_per_particle && k > 0)
+                for (int d = 0; d < 3; ++d) diag[d] = rng_uniform(&rng, o->F_min, o->F_max);
+            double *F = P->F + 9 * (first + k);
+            F[0] = diag[0], F[4] = diag[1], F[8] = diag[2];
+        }
+        sc->object_offsets[i + 1] = P->n;
+        sample_points_free(&pts);
+    }
+    poisson_tile_free(own);
+    return st;
+}
+
+/* ======================================================================
+ * Top level
+ * ====================================================================== */
+
+static int build(json_t *root, const char *file, const SceneLoadOptions *opt, const char *asset_dir, Scene *sc)
+{
+    static const char *const keys[] = {"name",       "description", "dx",     "fps",          "frames",
+                                       "cfl",        "max_dt",      "gravity", "apic_ratio",  "domain",
+                                       "domain_walls", "seed",      "materials", "objects",   "colliders",
+                                       NULL};
+    int st = sj_check_object(root, file, "", keys);
+    if (st) return st;
+    if ((st = read_name(root, "name", 1, file, "", sc->name, sizeof sc->name))) return st;
+    const char *desc = "";
+    if ((st = sj_string(root, "description", 0, file, "", &desc, NULL))) return st;
+    snprintf(sc->description, sizeof sc->description, "%s", desc);
+
+    double scale = opt && opt->scale != 0.0 ? opt->scale : 1.0;
+    if (!(scale > 0) || !isfinite(scale))
+        return mpm_error(MPM_EINPUT, "%s: --scale: expected a positive number, got %g", file, scale);
+    if ((st = sj_positive(root, "dx", 1, file, "", &sc->dx, NULL))) return st;
+    sc->dx *= scale;
+    if (!(sc->dx > 0) || !isfinite(sc->dx))
+        return mpm_error(MPM_EINPUT, "%s: dx: dx times --scale %g is not a positive finite number", file, scale);
+    if ((st = sj_positive(root, "fps", 1, file, "", &sc->fps, NULL))) return st;
+    double frames = 0;
+    if ((st = sj_number(root, "frames", 1, file, "", &frames, NULL))) return st;
+    if (!(frames >= 1 && frames <= 1e9 && frames == floor(frames)))
+        return sj_bad_number(file, "", "frames", "expected an integer >= 1", frames);
+    sc->frames = (int)frames;
+    sc->cfl = 0.6;
+    if ((st = sj_positive(root, "cfl", 0, file, "", &sc->cfl, NULL))) return st;
+    sc->max_dt = 1.0 / sc->fps;
+    if ((st = sj_positive(root, "max_dt", 0, file, "", &sc->max_dt, NULL))) return st;
+    if (!isfinite(sc->max_dt) || !(sc->max_dt > 0))
+        return sj_bad_number(file, "", "max_dt", "expected a positive number", sc->max_dt);
+    if ((st = sj_vec3(root, "gravity", 1, file, "", sc->gravity, NULL))) return st;
+    sc->apic_ratio = 1.0;
+    if ((st = sj_number(root, "apic_ratio", 0, file, "", &sc->apic_ratio, NULL))) return st;
+    if (!(sc->apic_ratio >= 0 && sc->apic_ratio <= 1))
+        return sj_bad_number(file, "", "apic_ratio", "expected a number in [0, 1]", sc->apic_ratio);
+
+    json_t *dom = json_object_get(root, "domain");
+    if (!dom) return mpm_error(MPM_EINPUT, "%s: domain: missing required field", file);
+    static const char *const dkeys[] = {"min", "max", NULL};
+    if ((st = sj_check_object(dom, file, "domain", dkeys))) return st;
+    if ((st = sj_vec3(dom, "min", 1, file, "domain", sc->domain_lo, NULL))) return st;
+    if ((st = sj_vec3(dom, "max", 1, file, "domain", sc->domain_hi, NULL))) return st;
+    for (int d = 0; d < 3; ++d)
+        if (!(sc->domain_hi[d] > sc->domain_lo[d]))
+            return sj_bad(file, "domain", "max", "expected max > min on every axis", json_object_get(dom, "max"));
+    int walls = 0;
+    if ((st = sj_bool(root, "domain_walls", 0, file, "", &walls, NULL))) return st;
+    sc->seed = 1;
+    json_t *seed = json_object_get(root, "seed");
+    if (seed) {
+        if (!json_is_integer(seed) || json_integer_value(seed) < 0)
+            return sj_bad(file, "", "seed", "expected a non-negative integer", seed);
+        sc->seed = (unsigned long long)json_integer_value(seed);
+    }
+
+    /* materials */
+    json_t *mats = json_object_get(root, "materials");
+    if (!mats) return mpm_error(MPM_EINPUT, "%s: materials: missing required field", file);
+    if (!json_is_object(mats) || json_object_size(mats) == 0)
+        return sj_bad(file, "", "materials", "expected an object of named materials", mats);
+    sc->materials = calloc(json_object_size(mats), sizeof(Material));
+    if (!sc->materials) return mpm_error(MPM_EINTERNAL, "out of memory");
+    const char *mname;
+    json_t *mj;
+    json_object_foreach(mats, mname, mj)
+    {
+        char p[512];
+        sj_path(p, sizeof p, "materials", mname);
+        if ((st = parse_material(mj, mname, file, p, &sc->materials[sc->n_materials]))) return st;
+        Material *m = &sc->materials[sc->n_materials++];
+        if (m->plasticity != PLASTICITY_NONE) sc->needs_plasticity = 1;
+    }
+
+    /* objects */
+    json_t *objs = json_object_get(root, "objects");
+    if (!objs) return mpm_error(MPM_EINPUT, "%s: objects: missing required field", file);
+    if (!json_is_array(objs) || json_array_size(objs) == 0)
+        return sj_bad(file, "", "objects", "expected a non-empty array of objects", objs);
+    size_t nobj = json_array_size(objs);
+    ObjectSpec *spec = calloc(nobj, sizeof *spec);
+    if (!spec) return mpm_error(MPM_EINTERNAL, "out of memory");
+    for (size_t i = 0; i < nobj && !st; ++i) {
+        char p[64];
+        sj_path_index(p, sizeof p, "objects", i);
+        st = parse_object(json_array_get(objs, i), file, p, (uint64_t)i, sc, asset_dir, &spec[i]);
+    }
+
+    /* colliders */
+    json_t *cols = json_object_get(root, "colliders");
+    if (!st && cols && !json_is_array(cols))
+        st = sj_bad(file, "", "colliders", "expected an array of colliders", cols);
+    if (!st) {
+        size_t nc = cols ? json_array_size(cols) : 0;
+        sc->colliders = calloc(nc + 6, sizeof(Collider));
+        if (!sc->colliders) st = mpm_error(MPM_EINTERNAL, "out of memory");
+        for (size_t i = 0; i < nc && !st; ++i) {
+            char p[64], defname[64];
+            sj_path_index(p, sizeof p, "colliders", i);
+            snprintf(defname, sizeof defname, "collider%zu", i);
+            st = collider_parse_named(json_array_get(cols, i), file, p, asset_dir, sc->dx, defname,
+                                      &sc->colliders[sc->n_colliders]);
+            if (!st) ++sc->n_colliders;
+        }
+        for (int a = 0; a < sc->n_colliders && !st; ++a)
+            for (int b = 0; b < a; ++b)
+                if (strcmp(sc->colliders[a].name, sc->colliders[b].name) == 0) {
+                    st = mpm_error(MPM_EINPUT, "%s: colliders.%d.name: duplicate collider name \"%s\"", file, a,
+                                   sc->colliders[a].name);
+                    break;
+                }
+        if (!st && walls) st = add_walls(sc, file);
+    }
+
+    if (!st) st = sample_objects(sc, file, spec, (int)nobj);
+    if (!st && sc->needs_plasticity) {
+        int snow = 0;
+        for (int k = 0; k < sc->n_materials; ++k) snow |= sc->materials[k].plasticity == PLASTICITY_SNOW;
+        if (snow) st = particles_enable_plastic_state(&sc->particles);
+    }
+    for (size_t i = 0; i < nobj; ++i) shape_free(spec[i].shape);
+    free(spec);
+    return st;
+}
+
+/* Line `line` (1-based) of a text file, whitespace-trimmed and shortened,
+ * so a JSON syntax error shows the field it is in. */
+static void source_line(const char *path, int line, char *out, size_t n)
+{
+    out[0] = '\0';
+    FILE *f = fopen(path, "r");
+    if (!f) return;
+    char buf[4096];
+    int k = 0;
+    while (fgets(buf, sizeof buf, f)) {
+        size_t len = strlen(buf);
+        if (++k == line) {
+            while (len && (buf[len - 1] == '\n' || buf[len - 1] == '\r' || buf[len - 1] == ' ')) buf[--len] = '\0';
+            const char *b = buf;
+            while (*b == ' ' || *b == '\t') ++b;
+            if (strlen(b) + 1 > n && n > 4)
+                snprintf(out, n, "%.*s...", (int)(n - 4), b);
+            else
+                snprintf(out, n, "%s", b);
+            break;
+        }
+        if (len && buf[len - 1] != '\n') { /* over-long line: skip the rest */
+            int c;
+            while ((c = fgetc(f)) != EOF && c != '\n') {
+            }
+        }
+    }
+    fclose(f);
+}
+
+int scene_load(const char *name_or_path, const SceneLoadOptions *opt, Scene *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!name_or_path || !name_or_path[0]) return mpm_error(MPM_EINPUT, "no scene given");
+    char path[1024];
+    if (is_builtin_name(name_or_path)) {
+        snprintf(path, sizeof path, "%s/%s.json", scene_dir(), name_or_path);
+        if (!file_exists(path)) {
+            char **names;
+            int n;
+            char list[512] = "";
+            if (list_names(&names, &n) == MPM_OK) {
+                size_t used = 0;
+                for (int k = 0; k < n && used + 70 < sizeof list; ++k) {
+                    int w = snprintf(list + used, sizeof list - used, "%s%s", k ? ", " : "", names[k]);
+                    if (w > 0) used += (size_t)w;
+                }
+                free_names(names, n);
+            }
+            mpm_clear_error(); /* a listing failure must not hide the real message */
+            return mpm_error(MPM_EINPUT, "unknown scene \"%s\" (built-in scenes in %s: %s)", name_or_path,
+                             scene_dir(), list[0] ? list : "none");
+        }
+    } else {
+        if (strlen(name_or_path) >= sizeof path)
+            return mpm_error(MPM_EINPUT, "scene path too long: %.80s...", name_or_path);
+        snprintf(path, sizeof path, "%s", name_or_path);
+        if (!file_exists(path)) return mpm_error(MPM_EINPUT, "%s: scene file not found", path);
+    }
+    snprintf(out->path, sizeof out->path, "%s", path);
+
+    json_error_t err;
+    json_t *root = json_load_file(path, JSON_REJECT_DUPLICATES, &err);
+    if (!root) {
+        if (err.line > 0) {
+            char src[96];
+            source_line(path, err.line, src, sizeof src);
+            return mpm_error(MPM_EINPUT, "%s:%d:%d: malformed JSON: %s (line %d: %s)", path, err.line, err.column,
+                             err.text, err.line, src);
+        }
+        return mpm_error(MPM_EINPUT, "%s: cannot read scene file: %s", path, err.text);
+    }
+    int st = MPM_OK;
+    if (opt)
+        for (int k = 0; k < opt->n_overrides && !st; ++k) st = apply_override(root, path, &opt->overrides[k]);
+    char adir[1024];
+    if (opt && opt->asset_dir && opt->asset_dir[0]) {
+        snprintf(adir, sizeof adir, "%s", opt->asset_dir);
+    } else {
+        const char *slash = strrchr(path, '/');
+        if (slash)
+            snprintf(adir, sizeof adir, "%.*s", (int)(slash - path), path);
+        else
+            snprintf(adir, sizeof adir, ".");
+    }
+    if (!st) st = build(root, path, opt, adir, out);
+    json_decref(root);
+    if (st) scene_free(out);
+    return st;
+}
+
+void scene_free(Scene *s)
+{
+    if (!s) return;
+    free(s->materials);
+    for (int k = 0; k < s->n_colliders; ++k) collider_free(&s->colliders[k]);
+    free(s->colliders);
+    particles_free(&s->particles);
+    free(s->object_offsets);
+    memset(s, 0, sizeof *s);
+}

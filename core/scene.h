@@ -1,0 +1,132 @@
+/* Scenes: JSON files describing one benchmark problem. The built-in scenes
+ * are experiments/scenes/NAME.json; nothing is hard-coded in C.
+ *
+ * ------------------------------------------------------------------------
+ * Scene file format (SI units, y up). Unknown fields anywhere are errors.
+ * ------------------------------------------------------------------------
+ * {
+ *   "name": "bar3",                   required, 1-63 characters
+ *   "description": "...",             optional
+ *   "dx": 0.0075,                     required, grid spacing [m] (> 0), times --scale
+ *   "fps": 48,                        required, frames per second (> 0)
+ *   "frames": 48,                     required, integer >= 1
+ *   "cfl": 0.6,                       optional (default 0.6), > 0
+ *   "max_dt": 0.0208333,              optional (default 1/fps), > 0
+ *   "gravity": [0, -9.8, 0],          required, m/s^2
+ *   "apic_ratio": 1,                  optional (default 1): APIC/RPIC blend r in
+ *                                     [0, 1]; 1 = APIC, 0 = RPIC
+ *   "domain": {"min": [..], "max": [..]},   required; every particle must lie
+ *                                     in it (max > min on every axis)
+ *   "domain_walls": true,             optional (default false): adds six sticky
+ *                                     half-space colliders at the domain faces
+ *                                     (named wall_x_min, ..., wall_z_max), like
+ *                                     the reference's safety walls
+ *   "seed": 1,                        optional (default 1), integer >= 0: seeds
+ *                                     the Poisson tile, random sampling and
+ *                                     random initial F
+ *   "materials": {                    required, at least one; declaration
+ *     "NAME": {                       order = material index
+ *       "E": 1e5,                     Young's modulus [Pa], > 0
+ *       "nu": 0.3,                    Poisson ratio, -1 < nu < 0.5
+ *       "density": 1000,              kg/m^3, > 0
+ *       "plasticity": {"type": "none"}                       optional
+ *                   | {"type": "von_mises", "yield_stress": tau_Y > 0}
+ *                   | {"type": "snow", "theta_c": in (0,1), "theta_s": >= 0,
+ *                      "hardening": >= 0 (default 0),
+ *                      "min_Jp": (default 0), "max_Jp": (default 1e30)}
+ *     }, ...
+ *   },
+ *   "objects": [                      required, at least one
+ *     {"name": "...",                 optional label
+ *      "material": "NAME",            required, a key of "materials"
+ *      "shape": {...},                required, see core/shape.h (must be bounded)
+ *      "ppc": 8,                      required, > 0 particles per dx^3 cell
+ *      "sampling": "poisson",         optional: "poisson" (default) | "random" |
+ *                                     "lattice" (ppc = k^3), see core/sampler.h
+ *      "velocity": [0, 0, 0],         optional initial velocity [m/s]
+ *      "initial_F": {"type": "random_diagonal", "min": 0.7, "max": 1.3,
+ *                    "seed": 7, "per_particle": true}
+ *                                     optional: F = diag(d0, d1, d2) with d_k
+ *                                     uniform in [min, max] (0 < min <= max),
+ *                                     per particle (default) or one for the
+ *                                     whole object; seed defaults to one
+ *                                     derived from the scene seed
+ *     }, ...
+ *   ],
+ *   "colliders": [ {...}, ... ]       optional, see core/collider.h
+ * }
+ *
+ * Particles: each object is sampled independently (overlapping objects keep
+ * both particle sets, as in the reference). Rest volume V_p = shape volume /
+ * number of samples, mass = density V_p, C = 0, F = I unless initial_F.
+ *
+ * Overrides (--set key=value) are applied to the JSON tree before validation.
+ * The key is a dot path: object members by key, array elements by index
+ * ("materials.middle.E", "colliders.1.motion.0.angular_velocity_deg.1",
+ * "frames"). The value is parsed as JSON (number, bool, array, object,
+ * quoted string) when it parses, else taken as a plain string. The path must
+ * exist, except that a missing optional field may be created in an existing
+ * top-level, material, plasticity, object or collider object.
+ *
+ * Errors: every validation failure returns MPM_EINPUT with one line naming
+ * the file, the JSON path of the field, the bad value and what was expected,
+ * e.g. "bar3.json: materials.middle.E: expected a positive number, got -5".
+ */
+#ifndef MPM_SCENE_H
+#define MPM_SCENE_H
+
+#include <stddef.h>
+
+#include "core/collider.h"
+#include "core/material.h"
+#include "core/particles.h"
+
+typedef struct {
+    const char *key;
+    const char *value;
+} SceneOverride; /* from --set key=value */
+
+typedef struct {
+    double scale;                     /* dx multiplier (0 means 1) */
+    const SceneOverride *overrides;
+    int n_overrides;
+    const char *asset_dir;            /* relative mesh paths; NULL: the scene file's directory */
+} SceneLoadOptions;
+
+typedef struct Scene {
+    char name[64];
+    char description[512];
+    char path[1024];
+    double dx;                        /* already multiplied by scale */
+    int frames;
+    double fps, cfl, max_dt;          /* cfl default 0.6, max_dt default 1/fps */
+    double gravity[3];
+    double apic_ratio;                /* RPIC/APIC blend r (1 = APIC, 0 = RPIC) */
+    double domain_lo[3], domain_hi[3];
+    Material *materials;              /* declaration order */
+    int n_materials;
+    Collider *colliders;              /* scene colliders, then the domain walls */
+    int n_colliders;
+    Particles particles;              /* initial state */
+    int needs_plasticity;             /* some material is plastic */
+    unsigned long long seed;
+    int n_objects;
+    size_t *object_offsets;           /* n_objects + 1: object k owns particles
+                                         [object_offsets[k], object_offsets[k+1]) */
+} Scene;
+
+/* Loads a built-in scene by name (no '/' and no ".json" suffix; looked up in
+ * getenv("MPM_SCENE_DIR"), else the compile-time MPM_SCENE_DIR) or a scene
+ * file by path. `opt` may be NULL (scale 1, no overrides). On failure *out
+ * is left empty (scene_free is still safe). */
+int scene_load(const char *name_or_path, const SceneLoadOptions *opt, Scene *out);
+void scene_free(Scene *s);
+
+/* The built-in scene directory in use. */
+const char *scene_dir(void);
+
+typedef void (*SceneListFn)(const char *name, const char *description, void *ctx);
+/* Calls fn for every built-in scene, sorted by name. */
+int scene_list(SceneListFn fn, void *ctx);
+
+#endif

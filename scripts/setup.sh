@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs the Debian packages mpmbench needs (only those missing, with
+# apt-get, non-interactively) and builds build/mpmbench. Idempotent: a second
+# run finds everything installed and the build up to date.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(build-essential cmake pkg-config libhypre-dev libsuitesparse-dev libgsl-dev
+          libopenmpi-dev openmpi-bin libjansson-dev libpng-dev)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  echo "setup: installing ${missing[*]}" >&2
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+if [ ! -f build/CMakeCache.txt ]; then
+  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+fi
+cmake --build build -j"$(nproc)" -- --no-print-directory >/dev/null
+echo "setup: build/mpmbench is ready" >&2

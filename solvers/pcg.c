@@ -1,0 +1,138 @@
+/* Preconditioned conjugate gradients from x = 0 (SPEC 5; HOT reference §4
+ * step 5 and §5.3).
+ *
+ *   x = 0;  r = P(b);  z = P(M^-1 r);  p = z;  rho0 = sqrt(r^T z)
+ *   loop (check at the top):
+ *     stop if sqrt(r^T z) < threshold         (forcing term or absolute)
+ *     stop if max_iters iterations were done  (capped = 1)
+ *     q = P(A p);  alpha = r^T z / p^T q
+ *     stop if p^T q <= 0                      (non-positive curvature)
+ *     x += alpha p;  r -= alpha q;  z = P(M^-1 r)
+ *     beta = r^T z_new / r^T z_old;  p = z + beta p
+ *
+ * Non-positive curvature: pcg.h has no flag for it, so it shows as a stop
+ * with capped == 0 and rho not below the threshold. Following Gast et al.
+ * 2015 §6 ("if indefiniteness is encountered during the conjugate gradient
+ * solve, return the last iterate computed; if this occurs on the first step,
+ * return the right hand side"), x is then the last iterate, or P(b) when it
+ * happens in the first iteration, so the result is always a descent direction
+ * for the quadratic model. With a projected (SPD) Hessian this never happens
+ * except at breakdown. All reductions go through vec_dot, so results are
+ * deterministic for a fixed thread count. */
+#include "solvers/pcg.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#include "core/error.h"
+#include "core/vec.h"
+
+static int pcg_work_reserve(PcgWork *w, int n)
+{
+    if (n <= w->cap_nodes) return MPM_OK;
+    size_t len = 3 * (size_t)n;
+    double **arr[4] = {&w->r, &w->z, &w->p, &w->q};
+    for (int k = 0; k < 4; ++k) {
+        double *a = realloc(*arr[k], sizeof(double) * len);
+        if (!a) return mpm_error(MPM_EINTERNAL, "out of memory: PCG work vectors (%d nodes)", n);
+        *arr[k] = a;
+    }
+    w->cap_nodes = n;
+    return MPM_OK;
+}
+
+void pcg_work_free(PcgWork *w)
+{
+    if (!w) return;
+    free(w->r);
+    free(w->z);
+    free(w->p);
+    free(w->q);
+    w->r = w->z = w->p = w->q = NULL;
+    w->cap_nodes = 0;
+}
+
+/* z = P(M^-1 r); M == NULL is the identity. */
+static int precondition(InvApprox *M, const Projection *proj, size_t len, const double *r, double *z)
+{
+    if (M) {
+        int st = M->ops->apply(M, r, z);
+        if (st) return st;
+    } else {
+        vec_copy(len, r, z);
+    }
+    projection_apply(proj, z);
+    return MPM_OK;
+}
+
+int pcg_solve(const LinearOp *A, InvApprox *M, const Projection *proj, const double *b, double *x,
+              const PcgOptions *opt, PcgWork *work, PcgResult *res)
+{
+    res->iters = 0;
+    res->capped = 0;
+    res->rho0 = res->rho = 0.0;
+    const int n = A->n_nodes;
+    const size_t len = 3 * (size_t)n;
+    int st = pcg_work_reserve(work, n);
+    if (st) return st;
+    double *r = work->r, *z = work->z, *p = work->p, *q = work->q;
+
+    vec_zero(len, x);
+    vec_copy(len, b, r);
+    projection_apply(proj, r);
+    st = precondition(M, proj, len, r, z);
+    if (st) return st;
+    double rz = vec_dot(len, r, z);
+    if (!isfinite(rz)) return mpm_error(MPM_EINTERNAL, "pcg: non-finite initial residual (r^T M^-1 r = %g)", rz);
+    if (rz < 0.0)
+        return mpm_error(MPM_EINTERNAL, "pcg: preconditioner is not positive definite (r^T M^-1 r = %g)", rz);
+    const double rho0 = sqrt(rz);
+    res->rho0 = res->rho = rho0;
+    if (rz == 0.0) return MPM_OK; /* b is zero in the free subspace: x = 0 is exact */
+
+    double threshold;
+    if (opt->stop == PCG_FORCING) {
+        double eta = fmin(0.5, sqrt(fmax(rho0, opt->tau)));
+        threshold = eta * rho0;
+    } else {
+        threshold = opt->abs_tol;
+    }
+
+    vec_copy(len, z, p);
+    double rho = rho0;
+    int it = 0;
+    for (;;) {
+        if (rho < threshold) break;
+        if (it >= opt->max_iters) {
+            res->capped = 1;
+            break;
+        }
+        A->apply(A->ctx, p, q);
+        projection_apply(proj, q);
+        double pq = vec_dot(len, p, q);
+        if (!(pq > 0.0)) { /* also catches NaN */
+            if (it == 0) vec_copy(len, r, x);
+            break;
+        }
+        double alpha = rz / pq;
+        vec_axpy(len, alpha, p, x);
+        vec_axpy(len, -alpha, q, r);
+        st = precondition(M, proj, len, r, z);
+        if (st) return st;
+        double rz_new = vec_dot(len, r, z);
+        ++it;
+        if (!isfinite(rz_new) || rz_new < 0.0) {
+            res->iters = it;
+            return mpm_error(MPM_EINTERNAL, "pcg: r^T M^-1 r = %g at iteration %d (preconditioner not SPD?)", rz_new,
+                             it);
+        }
+        double beta = rz_new / rz;
+        vec_xpby(len, z, beta, p);
+        rz = rz_new;
+        rho = sqrt(rz);
+        if (rz == 0.0) break; /* exact solution reached */
+    }
+    res->iters = it;
+    res->rho = rho;
+    return MPM_OK;
+}

@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# Command-line contract: listings, a short run writing the CSV files with the
+# documented columns, and bad input giving exit status 2 with one line that
+# names the problem.
+set -u
+bin="$1"
+src="$2"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fails=0
+checks=0
+
+check() { # description, condition-command...
+  local what="$1"; shift
+  checks=$((checks + 1))
+  if ! "$@"; then echo "FAIL: $what"; fails=$((fails + 1)); fi
+}
+
+# expect_input_error <pattern> <args...>: exit 2, exactly one stderr line matching pattern
+expect_input_error() {
+  local pattern="$1"; shift
+  "$bin" "$@" >"$tmp/out" 2>"$tmp/err"
+  local rc=$?
+  checks=$((checks + 1))
+  local lines
+  lines=$(wc -l <"$tmp/err")
+  if [ "$rc" -ne 2 ] || [ "$lines" -ne 1 ] || ! grep -qiE -e "$pattern" "$tmp/err"; then
+    echo "FAIL: '$*' gave exit $rc, stderr ($lines lines): $(cat "$tmp/err")  [wanted /$pattern/]"
+    fails=$((fails + 1))
+  fi
+}
+
+"$bin" list solvers >"$tmp/solvers"
+check "list solvers has pn-pcg" grep -q "^pn-pcg " "$tmp/solvers"
+check "list solvers has pn-pcg-mf" grep -q "^pn-pcg-mf " "$tmp/solvers"
+check "list solvers has pn-sgs-pcg" grep -q "^pn-sgs-pcg " "$tmp/solvers"
+"$bin" list scenes >"$tmp/scenes"
+for s in drop bar3 stretched-box; do check "list scenes has $s" grep -q "^$s " "$tmp/scenes"; done
+
+# a short run writes the three CSV files with the documented headers
+"$bin" run --scene drop --solver pn-pcg --frames 1 --out "$tmp/run" --history --quiet
+check "run exit 0" test $? -eq 0
+check "steps.csv header" grep -qx "scene,solver,frame,step,t,dt,particles,active_nodes,hessian_blocks,outer_iters,linear_iters,ls_evals,residual,status,wall_s,p2g_s,assemble_s,setup_s,solve_s,linesearch_s,g2p_s,threads" "$tmp/run/steps.csv"
+check "frames.csv header" grep -qx "scene,solver,frame,steps,outer_iters,linear_iters,wall_s,max_residual,status,threads" "$tmp/run/frames.csv"
+check "iters.csv header" grep -qx "frame,step,iter,elapsed_s,residual,energy" "$tmp/run/iters.csv"
+check "every step converged" awk -F, 'NR>1 && $14!="converged"{bad=1} END{exit bad}' "$tmp/run/steps.csv"
+check "frames.csv has one row" test "$(wc -l <"$tmp/run/frames.csv")" -eq 2
+check "run.json written" grep -q '"solver": "pn-pcg"' "$tmp/run/run.json"
+
+# bad usage and bad input
+expect_input_error "unknown solver 'nosuch'" run --scene drop --solver nosuch
+expect_input_error "nosuchscene" run --scene nosuchscene --solver pn-pcg
+expect_input_error "unknown command" frobnicate
+expect_input_error "--frames" run --scene drop --solver pn-pcg --frames -3
+expect_input_error "--eps" run --scene drop --solver pn-pcg --eps abc
+expect_input_error "unknown option" run --scene drop --solver pn-pcg --bogus
+expect_input_error "materials.ends.E|E.*-5" run --scene bar3 --solver pn-pcg --set materials.ends.E=-5
+expect_input_error "nu" run --scene bar3 --solver pn-pcg --set materials.middle.nu=0.5
+
+printf '{ "name": "broken", \n "dx": 0.1,, }\n' >"$tmp/malformed.json"
+expect_input_error "malformed.json" run --scene "$tmp/malformed.json" --solver pn-pcg
+python3 - "$src/experiments/scenes/drop.json" "$tmp" <<'PY'
+import json, sys
+src, tmp = sys.argv[1], sys.argv[2]
+base = json.load(open(src))
+def write(name, scene):
+    json.dump(scene, open(f"{tmp}/{name}.json", "w"), indent=1)
+s = json.loads(json.dumps(base)); del s["dx"]; write("missing", s)
+s = json.loads(json.dumps(base)); next(iter(s["materials"].values()))["E"] = 0; write("zeroE", s)
+s = json.loads(json.dumps(base)); next(iter(s["materials"].values()))["nu"] = 0.7; write("badnu", s)
+s = json.loads(json.dumps(base)); s["gravity"] = [0, "NaN", 0]; write("nan", s)
+PY
+expect_input_error "missing.json.*dx" run --scene "$tmp/missing.json" --solver pn-pcg
+expect_input_error "zeroE.json.*E" run --scene "$tmp/zeroE.json" --solver pn-pcg
+expect_input_error "badnu.json.*nu" run --scene "$tmp/badnu.json" --solver pn-pcg
+expect_input_error "nan.json.*gravity" run --scene "$tmp/nan.json" --solver pn-pcg
+printf '{"name":"x","dx":0.1,"frames":1,"fps":24,"domain":{"min":[0,0,0],"max":[1,1,1]},"materials":{"m":{"E":1e5,"nu":0.3,"density":1000}},"objects":[{"material":"m","ppc":8,"shape":{"type":"sphere","center":[0.5,0.5,0.5],"radius":NaN}}]}' >"$tmp/nanlit.json"
+expect_input_error "nanlit.json" run --scene "$tmp/nanlit.json" --solver pn-pcg
+
+echo "$((checks - fails)) passed, $fails failed"
+[ "$fails" -eq 0 ]

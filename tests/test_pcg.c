@@ -1,0 +1,232 @@
+/* PCG (SPEC 5) with block and scalar Jacobi on synthetic SPD block matrices:
+ * convergence to tolerance, projection, the forcing-term stop, the cap,
+ * non-positive curvature, singular diagonal blocks, determinism. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "core/vec.h"
+#include "solvers/jacobi.h"
+#include "solvers/pcg.h"
+#include "tests/synthetic.h"
+#include "tests/testutil.h"
+
+static InvApprox *make_inv(const InvApproxOps *ops, const SynthProblem *p)
+{
+    InvApprox *M = NULL;
+    int st = ops->create(NULL, &M);
+    CHECK(st == MPM_OK, "%s create: %s", ops->name, mpm_last_error());
+    InvSetupInput in = {.n_nodes = p->n, .H = &p->A, .diag = p->diag, .coord = p->coord, .coloring = &p->col,
+                        .op = &p->op, .proj = &p->proj};
+    st = ops->setup(M, &in);
+    CHECK(st == MPM_OK, "%s setup: %s", ops->name, mpm_last_error());
+    return M;
+}
+
+/* ||P(b - A x)|| / ||P b|| */
+static double rel_residual(const SynthProblem *p, const double *b, const double *x)
+{
+    size_t len = 3 * (size_t)p->n;
+    double *r = malloc(sizeof(double) * len), *pb = malloc(sizeof(double) * len);
+    bsr_spmv(&p->A, x, r);
+    for (size_t k = 0; k < len; ++k) r[k] = b[k] - r[k];
+    projection_apply(&p->proj, r);
+    vec_copy(len, b, pb);
+    projection_apply(&p->proj, pb);
+    double v = vec_norm(len, r) / vec_norm(len, pb);
+    free(r);
+    free(pb);
+    return v;
+}
+
+static void neg_spmv(const void *ctx, const double *x, double *y)
+{
+    const Bsr *A = ctx;
+    bsr_spmv(A, x, y);
+    for (int k = 0; k < 3 * A->n; ++k) y[k] = -y[k];
+}
+
+int main(void)
+{
+    SynthProblem p;
+    SynthParams sp = {.center = {-5, 7, -3}, .radius = 9.0, .reach = 2, .mass = 1.0, .stiff = 1000.0,
+                      .dirichlet = 1, .seed = 42};
+    int st = synth_build(&p, &sp);
+    CHECK(st == MPM_OK, "synth_build: %s", mpm_last_error());
+    if (st) return test_summary("test_pcg");
+    printf("synthetic problem: %d nodes, %d Dirichlet, %lld blocks (%.1f per row)\n", p.n, p.n_fixed,
+           (long long)p.A.nnzb, (double)p.A.nnzb / p.n);
+    size_t len = 3 * (size_t)p.n;
+    double *b = malloc(sizeof(double) * len), *x = malloc(sizeof(double) * len), *x2 = malloc(sizeof(double) * len);
+    synth_random_vector(p.n, 7, b);
+
+    InvApprox *bj = make_inv(&inv_block_jacobi_ops, &p);
+    InvApprox *sj = make_inv(&inv_scalar_jacobi_ops, &p);
+    PcgWork work = {0};
+    PcgResult res;
+
+    /* 1. solve to a tight absolute tolerance with each preconditioner */
+    int iters_block = 0, iters_scalar = 0, iters_none = 0;
+    {
+        PcgOptions o = {.stop = PCG_ABSOLUTE, .abs_tol = 0.0, .max_iters = 10000};
+        /* abs_tol relative to rho0: first learn rho0 with a zero-iteration cap */
+        o.max_iters = 0;
+        pcg_solve(&p.op, bj, &p.proj, b, x, &o, &work, &res);
+        CHECK(res.capped == 1 && res.iters == 0, "cap 0: capped %d iters %d", res.capped, res.iters);
+        o.abs_tol = 1e-10 * res.rho0;
+        o.max_iters = 10000;
+        st = pcg_solve(&p.op, bj, &p.proj, b, x, &o, &work, &res);
+        CHECK(st == MPM_OK, "pcg block: %s", mpm_last_error());
+        CHECK(!res.capped && res.rho < o.abs_tol, "block: capped %d rho %g tol %g", res.capped, res.rho, o.abs_tol);
+        double rr = rel_residual(&p, b, x);
+        CHECK(rr < 1e-8, "block-Jacobi PCG relative residual %g", rr);
+        iters_block = res.iters;
+        int fixed_ok = 1;
+        for (int i = 0; i < p.n; ++i)
+            if (p.fixed[i] && (x[3 * i] != 0.0 || x[3 * i + 1] != 0.0 || x[3 * i + 2] != 0.0)) fixed_ok = 0;
+        CHECK(fixed_ok, "Dirichlet nodes must stay exactly zero");
+
+        /* determinism: same input, same bits */
+        st = pcg_solve(&p.op, bj, &p.proj, b, x2, &o, &work, &res);
+        CHECK(memcmp(x, x2, sizeof(double) * len) == 0 && res.iters == iters_block, "pcg not deterministic");
+
+        st = pcg_solve(&p.op, sj, &p.proj, b, x, &o, &work, &res); /* tolerance in its own norm */
+        CHECK(st == MPM_OK && !res.capped, "scalar: st %d capped %d", st, res.capped);
+        o.abs_tol = 1e-10 * res.rho0;
+        st = pcg_solve(&p.op, sj, &p.proj, b, x, &o, &work, &res);
+        rr = rel_residual(&p, b, x);
+        CHECK(rr < 1e-8, "scalar-Jacobi PCG relative residual %g", rr);
+        iters_scalar = res.iters;
+
+        o.max_iters = 0;
+        pcg_solve(&p.op, NULL, &p.proj, b, x, &o, &work, &res);
+        o.abs_tol = 1e-10 * res.rho0;
+        o.max_iters = 10000;
+        st = pcg_solve(&p.op, NULL, &p.proj, b, x, &o, &work, &res);
+        rr = rel_residual(&p, b, x);
+        CHECK(st == MPM_OK && rr < 1e-8, "unpreconditioned CG relative residual %g", rr);
+        iters_none = res.iters;
+        printf("iterations to 1e-10: block Jacobi %d, scalar Jacobi %d, none %d\n", iters_block, iters_scalar,
+               iters_none);
+        CHECK(iters_block > 5 && iters_block < 1000, "block-Jacobi iterations %d", iters_block);
+        CHECK(iters_block <= iters_scalar + 5, "block %d vs scalar %d", iters_block, iters_scalar);
+    }
+
+    /* 2. forcing term: stops at the first iteration with rho < eta rho0 */
+    {
+        const double scales[2] = {1.0, 1e-7};
+        for (int si = 0; si < 2; ++si) {
+            double *bs = malloc(sizeof(double) * len);
+            for (size_t k = 0; k < len; ++k) bs[k] = b[k] * scales[si];
+            PcgOptions o = {.stop = PCG_FORCING, .tau = 1e-5, .max_iters = 10000};
+            st = pcg_solve(&p.op, bj, &p.proj, bs, x, &o, &work, &res);
+            double eta = fmin(0.5, sqrt(fmax(res.rho0, o.tau)));
+            CHECK(st == MPM_OK && !res.capped, "forcing: st %d capped %d", st, res.capped);
+            CHECK(res.rho < eta * res.rho0, "forcing: rho %g >= eta rho0 %g", res.rho, eta * res.rho0);
+            int it = res.iters;
+            CHECK(it >= 1, "forcing: at least one iteration (%d)", it);
+            PcgOptions o2 = o;
+            o2.max_iters = it - 1;
+            PcgResult r2;
+            pcg_solve(&p.op, bj, &p.proj, bs, x2, &o2, &work, &r2);
+            CHECK(r2.capped == 1 && r2.iters == it - 1 && r2.rho >= eta * r2.rho0,
+                  "forcing: one iteration earlier must not satisfy the rule (capped %d iters %d rho %g)", r2.capped,
+                  r2.iters, r2.rho);
+            /* the same stop as an absolute tolerance eta rho0 */
+            PcgOptions o3 = {.stop = PCG_ABSOLUTE, .abs_tol = eta * res.rho0, .max_iters = 10000};
+            pcg_solve(&p.op, bj, &p.proj, bs, x2, &o3, &work, &r2);
+            CHECK(r2.iters == it, "forcing vs absolute: %d vs %d iterations", it, r2.iters);
+            printf("forcing rule (rho0 %.3g, eta %.3g): %d iterations\n", res.rho0, eta, it);
+            if (si == 1) CHECK(fabs(eta - sqrt(o.tau)) < 1e-15, "tau floor: eta %g", eta);
+            free(bs);
+        }
+    }
+
+    /* 3. the cap */
+    {
+        PcgOptions o = {.stop = PCG_ABSOLUTE, .abs_tol = 0.0, .max_iters = 3};
+        st = pcg_solve(&p.op, bj, &p.proj, b, x, &o, &work, &res);
+        CHECK(st == MPM_OK && res.capped == 1 && res.iters == 3, "cap: st %d capped %d iters %d", st, res.capped,
+              res.iters);
+    }
+
+    /* 4. zero right-hand side (in the free subspace) */
+    {
+        double *bz = calloc(len, sizeof(double));
+        for (int i = 0; i < p.n; ++i)
+            if (p.fixed[i]) bz[3 * i] = 1.0; /* projected away */
+        PcgOptions o = {.stop = PCG_FORCING, .tau = 1e-5, .max_iters = 10000};
+        st = pcg_solve(&p.op, bj, &p.proj, bz, x, &o, &work, &res);
+        CHECK(st == MPM_OK && res.iters == 0 && res.rho0 == 0.0 && vec_norm(len, x) == 0.0,
+              "zero rhs: iters %d rho0 %g", res.iters, res.rho0);
+        free(bz);
+    }
+
+    /* 5. non-positive curvature: stop without dividing, return P(b) at iteration 0 */
+    {
+        LinearOp neg = {.n_nodes = p.n, .apply = neg_spmv, .ctx = &p.A};
+        PcgOptions o = {.stop = PCG_FORCING, .tau = 1e-5, .max_iters = 10000};
+        st = pcg_solve(&neg, NULL, &p.proj, b, x, &o, &work, &res);
+        vec_copy(len, b, x2);
+        projection_apply(&p.proj, x2);
+        CHECK(st == MPM_OK && res.iters == 0 && res.capped == 0 && memcmp(x, x2, sizeof(double) * len) == 0,
+              "indefinite: st %d iters %d capped %d", st, res.iters, res.capped);
+    }
+
+    /* 6. work arrays grow: a larger problem after a smaller one */
+    {
+        SynthProblem q;
+        SynthParams sq = sp;
+        sq.radius = 11.0;
+        sq.dirichlet = 0;
+        st = synth_build(&q, &sq);
+        CHECK(st == MPM_OK, "synth_build: %s", mpm_last_error());
+        size_t lq = 3 * (size_t)q.n;
+        double *bq = malloc(sizeof(double) * lq), *xq = malloc(sizeof(double) * lq);
+        synth_random_vector(q.n, 9, bq);
+        InvApprox *bq_j = make_inv(&inv_block_jacobi_ops, &q);
+        PcgOptions o = {.stop = PCG_FORCING, .tau = 1e-5, .max_iters = 10000};
+        st = pcg_solve(&q.op, bq_j, NULL, bq, xq, &o, &work, &res);
+        CHECK(st == MPM_OK && work.cap_nodes >= q.n && !res.capped, "grown work: st %d cap %d", st, work.cap_nodes);
+        bq_j->ops->destroy(bq_j);
+        free(bq);
+        free(xq);
+        synth_free(&q);
+    }
+
+    /* 7. singular diagonal block -> MPM_EINTERNAL naming the node */
+    {
+        double *d = malloc(sizeof(double) * 9 * (size_t)p.n);
+        memcpy(d, p.diag, sizeof(double) * 9 * (size_t)p.n);
+        memset(d + 9 * 17, 0, 9 * sizeof(double));
+        d[9 * 17] = 1.0;
+        d[9 * 17 + 4] = 1.0; /* rank 2 */
+        InvApprox *M = NULL;
+        inv_block_jacobi_ops.create(NULL, &M);
+        InvSetupInput in = {.n_nodes = p.n, .diag = d};
+        mpm_clear_error();
+        st = M->ops->setup(M, &in);
+        CHECK(st == MPM_EINTERNAL && strstr(mpm_last_error(), "node 17"), "singular block: st %d msg '%s'", st,
+              mpm_last_error());
+        M->ops->destroy(M);
+        inv_scalar_jacobi_ops.create(NULL, &M);
+        mpm_clear_error();
+        st = M->ops->setup(M, &in);
+        CHECK(st == MPM_EINTERNAL && strstr(mpm_last_error(), "node 17"), "zero diagonal entry: st %d msg '%s'", st,
+              mpm_last_error());
+        M->ops->destroy(M);
+        mpm_clear_error();
+        free(d);
+    }
+
+    bj->ops->destroy(bj);
+    sj->ops->destroy(sj);
+    pcg_work_free(&work);
+    free(b);
+    free(x);
+    free(x2);
+    synth_free(&p);
+    return test_summary("test_pcg");
+}
