@@ -143,8 +143,11 @@ static void compute_bases(const Particles *p, int *base, double inv_dx)
         for (int d = 0; d < 3; ++d) base[3 * k + d] = (int)floor(p->x[3 * k + d] * inv_dx - 0.5);
 }
 
-/* Keeps particles sorted by the block of their base node (stable, so the
- * order inside a block is deterministic). Cheap when already sorted. */
+/* Keeps particles sorted by base node in node_order_key order: grouped by
+ * block (for the colouring) and, inside a block, by cell, so particles that
+ * share all 27 stencil nodes are contiguous (the Hessian assembly sums them
+ * locally before scattering). Stable, hence deterministic; cheap when
+ * already sorted. */
 static int sort_particles(Particles *p, Stencils *st, double inv_dx)
 {
     size_t n = p->n;
@@ -152,8 +155,7 @@ static int sort_particles(Particles *p, Stencils *st, double inv_dx)
     int sorted = 1;
     uint64_t prev = 0;
     for (size_t k = 0; k < n && sorted; ++k) {
-        int b[3] = {st->base[3 * k] & ~3, st->base[3 * k + 1] & ~3, st->base[3 * k + 2] & ~3};
-        uint64_t key = node_order_key(b);
+        uint64_t key = node_order_key(st->base + 3 * k);
         if (k > 0 && key < prev) sorted = 0;
         prev = key;
     }
@@ -161,8 +163,7 @@ static int sort_particles(Particles *p, Stencils *st, double inv_dx)
     SortItem *items = malloc(sizeof(SortItem) * n);
     if (!items) return mpm_error(MPM_EINTERNAL, "out of memory sorting particles");
     for (size_t k = 0; k < n; ++k) {
-        int b[3] = {st->base[3 * k] & ~3, st->base[3 * k + 1] & ~3, st->base[3 * k + 2] & ~3};
-        items[k].key = node_order_key(b);
+        items[k].key = node_order_key(st->base + 3 * k);
         items[k].idx = k;
     }
     qsort(items, n, sizeof(SortItem), cmp_sort_item);

@@ -416,6 +416,34 @@ static inline void add_complement(const StepProblem *pb, int i, double *B)
     for (int e = 0; e < 9; ++e) B[e] += ((e % 4 == 0) ? 1.0 : 0.0) - P[e];
 }
 
+/* Adds one particle's stiffness to a cell-local dense buffer
+ * Kloc[s][t][3x3] (t >= s): K_st[a][c] = s_p sum_{b,d} A[(a,b),(c,d)] a_s(b) a_t(d).
+ * The a-vectors are laid out per component (ax[t], ay[t], az[t]) so the
+ * innermost loop over t is contiguous and vectorises. */
+static void accumulate_particle(const double *A, const double *a, double sp, double *Kloc)
+{
+    double ax[27], ay[27], az[27];
+    for (int t = 0; t < 27; ++t) {
+        ax[t] = a[3 * t];
+        ay[t] = a[3 * t + 1];
+        az[t] = a[3 * t + 2];
+    }
+    for (int s = 0; s < 27; ++s) {
+        if (ax[s] == 0.0 && ay[s] == 0.0 && az[s] == 0.0) continue; /* zero weight gradient */
+        double B[27];
+        contract_left(A, a + 3 * s, B);
+        for (int e = 0; e < 27; ++e) B[e] *= sp;
+        double *Ks = Kloc + 9 * 27 * s;
+        for (int ac = 0; ac < 9; ++ac) {
+            /* row (a, c) of every block K_st: B[a][3c + d] a_t(d) */
+            const double b0 = B[9 * (ac / 3) + 3 * (ac % 3)], b1 = B[9 * (ac / 3) + 3 * (ac % 3) + 1],
+                         b2 = B[9 * (ac / 3) + 3 * (ac % 3) + 2];
+            double *Kc = Ks + 27 * ac; /* layout [s][ac][t] */
+            for (int t = s; t < 27; ++t) Kc[t] += b0 * ax[t] + b1 * ay[t] + b2 * az[t];
+        }
+    }
+}
+
 int problem_assemble(StepProblem *pb, Bsr *H)
 {
     int status;
@@ -428,32 +456,49 @@ int problem_assemble(StepProblem *pb, Bsr *H)
     memset(H->val, 0, sizeof(double) * 9 * (size_t)H->nnzb);
     const NodeColoring *pc = &st->pcolor;
     for (int c = 0; c < MPM_NUM_COLORS; ++c) {
-#pragma omp parallel for schedule(dynamic, 2)
-        for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
-            int q = pc->color_blocks[qi];
-            double B[27], K[9];
-            for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
-                const int *node = st->node + 27 * (size_t)k;
-                const double *a = pb->a + 81 * (size_t)k, *A = pb->A + 81 * (size_t)k;
-                double s = dt2 * p->vol[k];
-                for (int si = 0; si < 27; ++si) {
-                    int i = node[si];
-                    if (i < 0) continue;
-                    contract_left(A, a + 3 * si, B);
-                    const short *slot_i = pb->slot + NEIGH * (size_t)i;
-                    int64_t r0 = H->row_ptr[i];
-                    for (int ti = si; ti < 27; ++ti) {
-                        int j = node[ti];
-                        if (j < 0) continue;
-                        contract_right(B, a + 3 * ti, s, K);
-                        double *Hij = H->val + 9 * (r0 + slot_i[g_pair_offset[si][ti]]);
-                        for (int e = 0; e < 9; ++e) Hij[e] += K[e];
-                        if (ti != si) {
-                            double *Hji = H->val + 9 * (H->row_ptr[j] + pb->slot[NEIGH * (size_t)j + g_pair_offset[ti][si]]);
-                            for (int r = 0; r < 3; ++r)
-                                for (int cc = 0; cc < 3; ++cc) Hji[3 * r + cc] += K[3 * cc + r];
+#pragma omp parallel
+        {
+            /* particles sharing a base node share all 27 stencil nodes: sum
+             * them in a dense cell buffer, scatter once per cell */
+            static _Thread_local double Kloc[27 * 27 * 9]; /* no allocation per call */
+#pragma omp for schedule(dynamic, 2)
+            for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
+                int q = pc->color_blocks[qi];
+                int k = pc->block_start[q], kend = pc->block_start[q + 1];
+                while (k < kend) {
+                    const int *b0 = st->base + 3 * (size_t)k;
+                    int k1 = k + 1;
+                    while (k1 < kend && memcmp(st->base + 3 * (size_t)k1, b0, 3 * sizeof(int)) == 0) ++k1;
+                    memset(Kloc, 0, sizeof(double) * 27 * 27 * 9);
+                    for (int kk = k; kk < k1; ++kk)
+                        accumulate_particle(pb->A + 81 * (size_t)kk, pb->a + 81 * (size_t)kk, dt2 * p->vol[kk], Kloc);
+                    /* node ids of the cell: union over its particles (a node
+                     * is -1 only where every weight vanishes) */
+                    int node[27];
+                    memcpy(node, st->node + 27 * (size_t)k, sizeof node);
+                    for (int kk = k + 1; kk < k1; ++kk)
+                        for (int t = 0; t < 27; ++t)
+                            if (node[t] < 0) node[t] = st->node[27 * (size_t)kk + t];
+                    for (int si = 0; si < 27; ++si) {
+                        int i = node[si];
+                        if (i < 0) continue;
+                        const short *slot_i = pb->slot + NEIGH * (size_t)i;
+                        int64_t r0 = H->row_ptr[i];
+                        const double *Ks = Kloc + 9 * 27 * si;
+                        for (int ti = si; ti < 27; ++ti) {
+                            int j = node[ti];
+                            if (j < 0) continue;
+                            double *Hij = H->val + 9 * (r0 + slot_i[g_pair_offset[si][ti]]);
+                            for (int e = 0; e < 9; ++e) Hij[e] += Ks[27 * e + ti];
+                            if (ti != si) {
+                                double *Hji =
+                                    H->val + 9 * (H->row_ptr[j] + pb->slot[NEIGH * (size_t)j + g_pair_offset[ti][si]]);
+                                for (int r = 0; r < 3; ++r)
+                                    for (int cc = 0; cc < 3; ++cc) Hji[3 * r + cc] += Ks[27 * (3 * cc + r) + ti];
+                            }
                         }
                     }
+                    k = k1;
                 }
             }
         }
