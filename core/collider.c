@@ -4,7 +4,9 @@
  * p(t) = pivot0 + b(t), the pose R(t) obeys dR/dt = [omega]x R, whose exact
  * solution over a phase of constant omega is R(t) = exp([omega]x tau) R0
  * (Rodrigues' formula, m3_rotation); the material velocity at x is
- * omega x (x - p(t)) + db/dt. */
+ * omega x (x - p(t)) + db/dt. The optional oscillation adds a closed-form
+ * translation a sin(w t + p) to b(t) (and a w cos(w t + p) to db/dt), the
+ * optional material velocity R(t) v_m to the velocity. */
 #include "core/collider.h"
 
 #include <math.h>
@@ -38,9 +40,27 @@ static void pose_in_phase(const ColliderPhase *ph, double t, double R[9], double
     for (int k = 0; k < 3; ++k) b[k] = ph->b0[k] + ph->vel[k] * tau;
 }
 
+/* Adds the oscillation's displacement (and, with vel non-NULL, its velocity). */
+static void add_oscillation(const Collider *c, double t, double b[3], double vel[3])
+{
+    if (!c->has_osc) return;
+    for (int k = 0; k < 3; ++k) {
+        double arg = c->osc_omega[k] * t + c->osc_phase[k];
+        b[k] += c->osc_amp[k] * sin(arg);
+        if (vel) vel[k] += c->osc_amp[k] * c->osc_omega[k] * cos(arg);
+    }
+}
+
+/* Full pose in phase ph: the phase's rigid pose plus the oscillation. */
+static void full_pose(const Collider *c, const ColliderPhase *ph, double t, double R[9], double b[3])
+{
+    pose_in_phase(ph, t, R, b);
+    add_oscillation(c, t, b, NULL);
+}
+
 void collider_pose(const Collider *c, double t, double R[9], double b[3])
 {
-    pose_in_phase(&c->phases[find_phase(c, t)], t, R, b);
+    full_pose(c, &c->phases[find_phase(c, t)], t, R, b);
 }
 
 int collider_active(const Collider *c, double t) { return !c->phases[find_phase(c, t)].removed; }
@@ -60,7 +80,7 @@ double collider_phi(const Collider *c, double t, const double x[3], double norma
         return HUGE_VAL;
     }
     double R[9], b[3], X[3];
-    pose_in_phase(ph, t, R, b);
+    full_pose(c, ph, t, R, b);
     to_rest(c, R, b, x, X);
     double phi = shape_sdf(c->shape, X);
     if (normal) {
@@ -89,11 +109,14 @@ static void velocity_in_phase(const Collider *c, const ColliderPhase *ph, double
         v[0] = v[1] = v[2] = 0.0;
         return;
     }
-    double tau = t - ph->t_start;
-    double r[3], wr[3];
-    for (int k = 0; k < 3; ++k) r[k] = x[k] - (c->pivot0[k] + ph->b0[k] + ph->vel[k] * tau);
+    double R[9], b[3], osc_v[3] = {0, 0, 0};
+    pose_in_phase(ph, t, R, b);
+    add_oscillation(c, t, b, osc_v);
+    double r[3], wr[3], mv[3];
+    for (int k = 0; k < 3; ++k) r[k] = x[k] - (c->pivot0[k] + b[k]);
     v3_cross(ph->omega, r, wr);
-    for (int k = 0; k < 3; ++k) v[k] = wr[k] + ph->vel[k];
+    m3_mulv(R, c->material_vel, mv);
+    for (int k = 0; k < 3; ++k) v[k] = wr[k] + ph->vel[k] + osc_v[k] + mv[k];
 }
 
 void collider_velocity(const Collider *c, double t, const double x[3], double v[3])
@@ -105,6 +128,7 @@ double collider_max_speed(const Collider *c, double t, const double lo[3], const
 {
     const ColliderPhase *ph = &c->phases[find_phase(c, t)];
     if (ph->removed) return 0.0;
+    if (c->cfl_speed >= 0.0) return c->cfl_speed;
     /* Current world bounds of the collider: the rest bounds' corners posed. */
     double slo[3], shi[3], blo[3], bhi[3];
     shape_bounds(c->shape, slo, shi);
@@ -114,7 +138,7 @@ double collider_max_speed(const Collider *c, double t, const double lo[3], const
     memcpy(box_hi, hi, sizeof box_hi);
     if (bounded) {
         double R[9], b[3];
-        pose_in_phase(ph, t, R, b);
+        full_pose(c, ph, t, R, b);
         for (int k = 0; k < 3; ++k) blo[k] = HUGE_VAL, bhi[k] = -HUGE_VAL;
         for (int corner = 0; corner < 8; ++corner) {
             double X[3], d[3], w[3];
@@ -185,6 +209,27 @@ static int parse_phase(json_t *j, const char *file, const char *path, int is_las
     return MPM_OK;
 }
 
+static int parse_oscillation(json_t *j, const char *file, const char *path, Collider *c)
+{
+    json_t *o = json_object_get(j, "oscillation");
+    if (!o) return MPM_OK;
+    char p[512];
+    sj_path(p, sizeof p, path, "oscillation");
+    static const char *const keys[] = {"amplitude", "angular_frequency_deg", "phase_deg", NULL};
+    int st = sj_check_object(o, file, p, keys);
+    if (st) return st;
+    double w[3] = {0, 0, 0}, ph[3] = {0, 0, 0};
+    if ((st = sj_vec3(o, "amplitude", 1, file, p, c->osc_amp, NULL))) return st;
+    if ((st = sj_vec3(o, "angular_frequency_deg", 1, file, p, w, NULL))) return st;
+    if ((st = sj_vec3(o, "phase_deg", 0, file, p, ph, NULL))) return st;
+    for (int k = 0; k < 3; ++k) {
+        c->osc_omega[k] = w[k] * (M_PI / 180.0);
+        c->osc_phase[k] = ph[k] * (M_PI / 180.0);
+    }
+    c->has_osc = 1;
+    return MPM_OK;
+}
+
 static int parse_motion(json_t *j, const char *file, const char *path, Collider *c)
 {
     json_t *m = json_object_get(j, "motion");
@@ -221,7 +266,8 @@ static int parse_motion(json_t *j, const char *file, const char *path, Collider 
 int collider_parse_named(json_t *j, const char *file, const char *jpath, const char *asset_dir, double dx,
                          const char *default_name, Collider *out)
 {
-    static const char *const keys[] = {"name", "type", "shape", "pivot", "motion", NULL};
+    static const char *const keys[] = {"name",        "type",          "shape",     "pivot", "motion",
+                                       "oscillation", "material_velocity", "cfl_speed", NULL};
     Collider c;
     memset(&c, 0, sizeof c);
     memset(out, 0, sizeof *out);
@@ -248,8 +294,17 @@ int collider_parse_named(json_t *j, const char *file, const char *jpath, const c
     double lo[3], hi[3];
     shape_bounds(c.shape, lo, hi);
     for (int k = 0; k < 3; ++k) c.pivot0[k] = (isfinite(lo[k]) && isfinite(hi[k])) ? 0.5 * (lo[k] + hi[k]) : 0.0;
+    c.cfl_speed = -1.0;
+    int have_cfl = 0;
     if ((st = sj_vec3(j, "pivot", 0, file, jpath, c.pivot0, NULL)) ||
-        (st = parse_motion(j, file, jpath, &c))) {
+        (st = sj_vec3(j, "material_velocity", 0, file, jpath, c.material_vel, NULL)) ||
+        (st = sj_number(j, "cfl_speed", 0, file, jpath, &c.cfl_speed, &have_cfl)) ||
+        (st = parse_oscillation(j, file, jpath, &c)) || (st = parse_motion(j, file, jpath, &c))) {
+        collider_free(&c);
+        return st;
+    }
+    if (have_cfl && !(c.cfl_speed >= 0)) {
+        st = sj_bad_number(file, jpath, "cfl_speed", "expected a non-negative number", c.cfl_speed);
         collider_free(&c);
         return st;
     }

@@ -5,6 +5,7 @@
  *
  *     x = R(t) (X - pivot0) + pivot0 + b(t),
  *
+ * (b(t) includes the optional oscillation below)
  * pivot0 = the "pivot" field, or by default the centre of the shape's bounds
  * (0 on the axes where the bounds are unbounded, e.g. half-spaces). b(t) integrates the translation velocity and R(t) the angular
  * velocity about the moving pivot p(t) = pivot0 + b(t); the collider
@@ -16,6 +17,9 @@
  *    "shape": {...},                      required, see shape.h
  *    "pivot": [x, y, z],                  optional
  *    "motion": [phase, ...]}              optional, default: static forever
+ *    "oscillation": {...},                optional, see below
+ *    "material_velocity": [vx, vy, vz],   optional, default 0
+ *    "cfl_speed": s}                      optional
  *   phase = {"until": t_end,              seconds, absolute time; omit or null
  *                                         only on the last phase (= forever)
  *            "velocity": [vx, vy, vz],     m/s, default 0
@@ -28,6 +32,24 @@
  *   exact rotation exp(omega tau) onto the pose it starts from). If the last
  *   phase has an "until", the collider stays at rest (not removed) at its
  *   final pose afterwards. Times before 0 use the first phase.
+ *
+ * "oscillation": {"amplitude": [ax, ay, az],             m, default 0
+ *                 "angular_frequency_deg": [wx, wy, wz], deg/s, default 0
+ *                 "phase_deg": [px, py, pz]}             deg, default 0
+ *   adds a sinusoidal translation b_osc(t) with components
+ *   a_k sin(w_k t + p_k) (world axes, absolute time t) on top of the phases,
+ *   e.g. HOT's Sauce source whose centre is
+ *   (3 - 0.4 sin(55 deg/s t), 4.18, 2.857 + 0.5 sin(120 deg/s t)):
+ *   "oscillation": {"amplitude": [-0.4, 0, 0.5],
+ *                   "angular_frequency_deg": [55, 0, 120]}.
+ *   It applies in every phase (a "removed" phase still removes the collider).
+ * "material_velocity": velocity of the collider's material relative to its
+ *   rigid motion, in the rest frame (world value R(t) v_m); added to
+ *   collider_velocity, so sticky nodes inside move with it (the reference's
+ *   R s v_material term; particle sources use it for their outflow).
+ * "cfl_speed": the speed the collider reports to the CFL rule
+ *   (collider_max_speed) instead of its material speed; the reference's
+ *   source objects report only their material speed (0.5 m/s).
  *
  * Example (HOT Fig. 20 top cap, 360 deg/s about +y for 1 s, then stopped):
  *   "motion": [{"until": 1.0, "angular_velocity_deg": [0, 360, 0]},
@@ -60,6 +82,10 @@ typedef struct Collider {
     ColliderPhase *phases; /* n_phases >= 1 */
     int n_phases;
     double fd_h;           /* finite-difference step for normals (1e-3 dx) */
+    int has_osc;
+    double osc_amp[3], osc_omega[3], osc_phase[3]; /* m, rad/s, rad */
+    double material_vel[3]; /* rest frame, m/s */
+    double cfl_speed;      /* < 0: report the material speed (default) */
 } Collider;
 
 /* Parses one collider object. `file`/`jpath` name it in error messages
@@ -81,8 +107,10 @@ void collider_pose(const Collider *c, double t, double R[9], double b[3]);
  * ("removed") collider returns HUGE_VAL and a zero normal. */
 double collider_phi(const Collider *c, double t, const double x[3], double normal[3]);
 
-/* Rigid velocity of the collider material at world point x and time t
- * (zero while removed and after the last finite phase). */
+/* Velocity of the collider material at world point x and time t: the rigid
+ * motion omega x (x - p(t)) + db/dt (oscillation included) plus the
+ * material velocity R(t) v_m. Zero while removed; after the last finite
+ * phase only the oscillation and the material velocity remain. */
 void collider_velocity(const Collider *c, double t, const double x[3], double v[3]);
 
 /* 0 during a "removed" phase, 1 otherwise. */
@@ -92,7 +120,8 @@ int collider_active(const Collider *c, double t);
  * particle bounding box enlarged by a few dx), for the CFL time step: the
  * rigid speed |omega x r + v| is convex in x, so its maximum over a box is at
  * a corner. The box used is [lo, hi] intersected with the collider's current
- * world bounds when they overlap, else [lo, hi] itself. 0 when inactive. */
+ * world bounds when they overlap, else [lo, hi] itself. 0 when inactive;
+ * "cfl_speed" when the collider has one. */
 double collider_max_speed(const Collider *c, double t, const double lo[3], const double hi[3]);
 
 void collider_free(Collider *c);

@@ -419,6 +419,73 @@ static int sample_lattice(const Shape *s, const double lo[3], const double hi[3]
     return st;
 }
 
+/* Surface points: candidates uniform in the bounds (grown by h) in fixed
+ * blocks with their own random streams, kept when |phi| < h, projected onto
+ * phi = 0 along the (central-difference) gradient. A shell of constant
+ * half-width h around a smooth surface has volume 2 h area, and projecting
+ * its points along the normal spreads them uniformly by area up to
+ * O((h curvature)^2), because the shell is symmetric about the surface. */
+static int project_to_surface(const Shape *s, double h, double p[3])
+{
+    double phi = shape_sdf(s, p), e = 1e-3 * h;
+    for (int it = 0; it < 8; ++it) {
+        if (fabs(phi) <= 1e-6 * h) return 1;
+        double g[3], n2 = 0.0;
+        for (int d = 0; d < 3; ++d) {
+            double a[3] = {p[0], p[1], p[2]}, b[3] = {p[0], p[1], p[2]};
+            a[d] += e;
+            b[d] -= e;
+            g[d] = (shape_sdf(s, a) - shape_sdf(s, b)) / (2.0 * e);
+            n2 += g[d] * g[d];
+        }
+        if (!(n2 > 1e-12) || !isfinite(n2)) return 0;
+        for (int d = 0; d < 3; ++d) p[d] -= phi * g[d] / n2;
+        phi = shape_sdf(s, p);
+    }
+    return fabs(phi) <= 1e-3 * h;
+}
+
+int sampler_surface(const Shape *shape, size_t n, double h, uint64_t seed, SamplePoints *out)
+{
+    if (!(h > 0) || !isfinite(h)) return mpm_error(MPM_EINPUT, "surface sampling: h must be positive, got %g", h);
+    if (!shape_is_bounded(shape))
+        return mpm_error(MPM_EINPUT, "cannot sample the surface of an unbounded shape (%s)", shape_type_name(shape));
+    if (n == 0) return MPM_OK;
+    double lo[3], hi[3];
+    shape_bounds(shape, lo, hi);
+    for (int d = 0; d < 3; ++d) {
+        if (!(hi[d] >= lo[d])) return mpm_error(MPM_EINPUT, "surface sampling: empty shape");
+        lo[d] -= h;
+        hi[d] += h;
+    }
+    const size_t block = CHUNK, batch = 64;
+    size_t target = out->n + n, blk = 0;
+    double max_candidates = 1e5 * (double)n + 1e7;
+    Buf bufs[64];
+    memset(bufs, 0, sizeof bufs);
+    while (out->n < target) {
+        if ((double)(blk * block) > max_candidates)
+            return mpm_error(MPM_EINPUT, "surface sampling: too few candidates reach the surface (h = %g)", h);
+        int fail = 0;
+#pragma omp parallel for schedule(dynamic, 1) reduction(| : fail)
+        for (size_t b = 0; b < batch; ++b) {
+            Rng r;
+            rng_seed(&r, rng_mix(seed, blk + b));
+            for (size_t k = 0; k < block; ++k) {
+                double p[3] = {rng_uniform(&r, lo[0], hi[0]), rng_uniform(&r, lo[1], hi[1]),
+                               rng_uniform(&r, lo[2], hi[2])};
+                if (fabs(shape_sdf(shape, p)) >= h) continue;
+                if (project_to_surface(shape, h, p) && buf_push(&bufs[b], p)) fail = 1;
+            }
+        }
+        blk += batch;
+        int st = gather(bufs, batch, out, target);
+        if (fail) return mpm_error(MPM_EINTERNAL, "out of memory sampling");
+        if (st) return st;
+    }
+    return MPM_OK;
+}
+
 int sampler_sample(const Shape *shape, SamplingKind kind, double dx, double ppc, uint64_t seed,
                    const PoissonTile *tile, SamplePoints *out)
 {

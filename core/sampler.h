@@ -69,6 +69,15 @@ typedef struct {
 int sampler_sample(const Shape *shape, SamplingKind kind, double dx, double ppc, uint64_t seed,
                    const PoissonTile *tile, SamplePoints *out);
 
+/* n points on the surface of `shape` (bounded), spread uniformly by area
+ * to O((h curvature)^2): candidates uniform in the bounds within |phi| < h
+ * of the surface, projected onto phi = 0 along the gradient (Newton steps
+ * on phi, |phi| <= 1e-3 h at the end). Deterministic for a seed and any
+ * thread count. Appends to *out (min_dist is left unchanged). The scene uses
+ * it to stand in for the reference's mesh-vertex particles (scene.h,
+ * "surface_particles"); h = dx / 4 there. */
+int sampler_surface(const Shape *shape, size_t n, double h, uint64_t seed, SamplePoints *out);
+
 void sample_points_free(SamplePoints *p);
 
 #endif

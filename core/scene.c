@@ -13,8 +13,10 @@
 #include <sys/stat.h>
 
 #include "core/error.h"
+#include "core/mat3.h"
 #include "core/rng.h"
 #include "core/sampler.h"
+#include "core/source.h"
 
 #ifndef MPM_SCENE_DIR
 #define MPM_SCENE_DIR "experiments/scenes"
@@ -110,13 +112,16 @@ int scene_list(SceneListFn fn, void *ctx)
  * ====================================================================== */
 
 /* Optional fields that --set may create when absent, by context. */
-static const char *const k_top_optional[] = {"description", "cfl",  "max_dt", "apic_ratio",
-                                             "domain_walls", "seed", "colliders", NULL};
+static const char *const k_top_optional[] = {"description", "cfl",       "max_dt",  "apic_ratio", "domain_walls",
+                                             "seed",        "colliders", "sources", NULL};
 static const char *const k_mat_optional[] = {"plasticity", NULL};
 static const char *const k_plast_optional[] = {"yield_stress", "theta_c", "theta_s", "hardening",
                                                "min_Jp",       "max_Jp",  NULL};
-static const char *const k_obj_optional[] = {"name", "sampling", "velocity", "initial_F", NULL};
-static const char *const k_col_optional[] = {"name", "type", "pivot", "motion", NULL};
+static const char *const k_obj_optional[] = {"name", "sampling", "velocity", "initial_F", "surface_particles", NULL};
+static const char *const k_col_optional[] = {"name",        "type",              "pivot",     "motion",
+                                             "oscillation", "material_velocity", "cfl_speed", NULL};
+static const char *const k_src_optional[] = {"name",        "from",     "until",           "pivot", "motion",
+                                             "oscillation", "collider", "particle_volume", NULL};
 
 static int in_list(const char *const *list, const char *s)
 {
@@ -189,6 +194,8 @@ static int apply_override(json_t *root, const char *file, const SceneOverride *o
                 opt = k_obj_optional;
             else if (nt == 3 && strcmp(tok[0], "colliders") == 0)
                 opt = k_col_optional;
+            else if (nt == 3 && strcmp(tok[0], "sources") == 0)
+                opt = k_src_optional;
             if (!opt || !in_list(opt, leaf)) {
                 json_decref(val);
                 return mpm_error(MPM_EINPUT, "%s: --set %s: %s does not exist", file, o->key, lp);
@@ -304,7 +311,42 @@ typedef struct {
     double F_min, F_max;
     uint64_t F_seed;
     int F_per_particle;
+    size_t surf_n;   /* surface particles (after --scale) */
+    Shape *surf_mesh; /* "vertices_of": take (a subset of) its vertices; else surface samples */
 } ObjectSpec;
+
+/* "surface_particles": {"count": N} | {"vertices_of": mesh shape}. */
+static int parse_surface(json_t *j, const char *file, const char *path, const char *asset_dir, double dx,
+                         double scale, ObjectSpec *o)
+{
+    static const char *const keys[] = {"count", "vertices_of", NULL};
+    int st = sj_check_object(j, file, path, keys);
+    if (st) return st;
+    json_t *cnt = json_object_get(j, "count"), *vo = json_object_get(j, "vertices_of");
+    if ((cnt != NULL) == (vo != NULL))
+        return mpm_error(MPM_EINPUT, "%s: %s: expected exactly one of \"count\" and \"vertices_of\"", file, path);
+    double n = 0;
+    if (cnt) {
+        if ((st = sj_number(j, "count", 1, file, path, &n, NULL))) return st;
+        if (!(n >= 0 && n == floor(n) && n < 1e9))
+            return sj_bad_number(file, path, "count", "expected a non-negative integer", n);
+    } else {
+        char vp[512];
+        sj_path(vp, sizeof vp, path, "vertices_of");
+        if ((st = shape_parse(vo, file, vp, asset_dir, dx, &o->surf_mesh))) return st;
+        if (strcmp(shape_type_name(o->surf_mesh), "mesh") != 0)
+            return mpm_error(MPM_EINPUT, "%s: %s: expected a mesh shape, got a %s", file, vp,
+                             shape_type_name(o->surf_mesh));
+        double *v = NULL;
+        size_t nv = 0;
+        if ((st = shape_mesh_vertices(o->surf_mesh, &v, &nv))) return st;
+        free(v);
+        n = (double)nv;
+    }
+    /* the count is for scale 1; a coarser grid keeps the same share of particles */
+    o->surf_n = (size_t)llround(n / (scale * scale * scale));
+    return MPM_OK;
+}
 
 static int parse_initial_F(json_t *j, const char *file, const char *path, uint64_t default_seed,
                            ObjectSpec *o)
@@ -333,10 +375,10 @@ static int parse_initial_F(json_t *j, const char *file, const char *path, uint64
 }
 
 static int parse_object(json_t *j, const char *file, const char *path, uint64_t index, const Scene *sc,
-                        const char *asset_dir, ObjectSpec *o)
+                        const char *asset_dir, double scale, ObjectSpec *o)
 {
-    static const char *const keys[] = {"name", "material", "shape", "ppc", "sampling", "velocity", "initial_F",
-                                       NULL};
+    static const char *const keys[] = {"name",     "material",  "shape",          "ppc", "sampling",
+                                       "velocity", "initial_F", "surface_particles", NULL};
     int st = sj_check_object(j, file, path, keys);
     if (st) return st;
     const char *s = NULL;
@@ -383,6 +425,12 @@ static int parse_object(json_t *j, const char *file, const char *path, uint64_t 
         if ((st = parse_initial_F(fj, file, fp, rng_mix(sc->seed, 0xF000ull + index), o))) return st;
     }
     if ((st = shape_parse(sh, file, sp, asset_dir, sc->dx, &o->shape))) return st;
+    json_t *surf = json_object_get(j, "surface_particles");
+    if (surf) {
+        char up[512];
+        sj_path(up, sizeof up, path, "surface_particles");
+        if ((st = parse_surface(surf, file, up, asset_dir, sc->dx, scale, o))) return st;
+    }
     if (!shape_is_bounded(o->shape))
         return mpm_error(MPM_EINPUT, "%s: %s: an object's shape must be bounded (got an unbounded %s)", file, sp,
                          shape_type_name(o->shape));
@@ -420,6 +468,41 @@ static int add_walls(Scene *sc, const char *file)
     return MPM_OK;
 }
 
+/* The object's surface particles (the reference's .obj vertices): a
+ * deterministic subset of round(N / scale^3) vertices of "vertices_of"
+ * (evenly spaced in file order; all of them at scale 1), or that many
+ * sampler_surface points with h = dx / 4. */
+static int surface_points(const ObjectSpec *o, double dx, uint64_t seed, SamplePoints *pts)
+{
+    if (o->surf_n == 0) return MPM_OK;
+    if (!o->surf_mesh) return sampler_surface(o->shape, o->surf_n, 0.25 * dx, seed, pts);
+    double *v = NULL;
+    size_t nv = 0;
+    int st = shape_mesh_vertices(o->surf_mesh, &v, &nv);
+    if (st) return st;
+    size_t take = o->surf_n < nv ? o->surf_n : nv;
+    SamplePoints tmp = {0};
+    tmp.x = v;
+    tmp.n = tmp.cap = nv;
+    for (size_t k = 0; k < take && !st; ++k) {
+        size_t idx = (size_t)((double)k * (double)nv / (double)take);
+        if (idx >= nv) idx = nv - 1;
+        if (pts->n == pts->cap) {
+            size_t c = pts->cap ? 2 * pts->cap : 1024;
+            double *q = realloc(pts->x, sizeof(double) * 3 * c);
+            if (!q) {
+                st = mpm_error(MPM_EINTERNAL, "out of memory adding surface particles");
+                break;
+            }
+            pts->x = q;
+            pts->cap = c;
+        }
+        memcpy(pts->x + 3 * pts->n++, v + 3 * idx, 3 * sizeof(double));
+    }
+    sample_points_free(&tmp);
+    return st;
+}
+
 static int sample_objects(Scene *sc, const char *file, ObjectSpec *objs, int nobj)
 {
     PoissonTile *own = NULL;
@@ -444,8 +527,10 @@ static int sample_objects(Scene *sc, const char *file, ObjectSpec *objs, int nob
         sj_path_index(path, sizeof path, "objects", (size_t)i);
         SamplePoints pts;
         memset(&pts, 0, sizeof pts);
-        st = sampler_sample(o->shape, o->sampling, sc->dx, o->ppc, rng_mix(sc->seed, 0x5A00ull + (uint64_t)i), tile,
-                            &pts);
+        st = surface_points(o, sc->dx, rng_mix(sc->seed, 0x5F00ull + (uint64_t)i), &pts);
+        if (!st)
+            st = sampler_sample(o->shape, o->sampling, sc->dx, o->ppc, rng_mix(sc->seed, 0x5A00ull + (uint64_t)i),
+                                tile, &pts);
         if (st) {
             /* re-issue the sampler's message with the place in the file */
             char msg[900];
@@ -505,6 +590,56 @@ static int sample_objects(Scene *sc, const char *file, ObjectSpec *objs, int nob
     return st;
 }
 
+/* Sources (core/source.h): each may add a sticky collider after the scene's
+ * own colliders. */
+static int parse_sources(Scene *sc, json_t *srcs, const char *file, const char *asset_dir)
+{
+    size_t ns = json_array_size(srcs);
+    sc->sources = calloc(ns, sizeof(Source));
+    if (!sc->sources) return mpm_error(MPM_EINTERNAL, "out of memory");
+    const PoissonTile *tile = poisson_tile_shared(sc->seed);
+    PoissonTile *own = NULL;
+    int st = MPM_OK;
+    if (!tile) {
+        st = poisson_tile_create(sc->seed, &own);
+        tile = own;
+    }
+    for (size_t i = 0; i < ns && !st; ++i) {
+        char p[64], defname[64];
+        sj_path_index(p, sizeof p, "sources", i);
+        snprintf(defname, sizeof defname, "source%zu", i);
+        Collider col;
+        st = source_parse(json_array_get(srcs, i), file, p, asset_dir, sc->dx, sc->materials, sc->n_materials, tile,
+                          defname, &sc->sources[i], &col);
+        if (st) break;
+        sc->n_sources = (int)i + 1;
+        Source *s = &sc->sources[i];
+        if (s->has_collider) sc->colliders[sc->n_colliders++] = col;
+        /* the source must start inside the domain */
+        double lo[3], hi[3], R[9], b[3];
+        shape_bounds(s->pose.shape, lo, hi);
+        collider_pose(&s->pose, 0.0, R, b);
+        for (int c = 0; c < 8 && !st; ++c) {
+            double X[3], d[3], x[3];
+            for (int k = 0; k < 3; ++k) X[k] = (c >> k) & 1 ? hi[k] : lo[k];
+            for (int k = 0; k < 3; ++k) d[k] = X[k] - s->pose.pivot0[k];
+            m3_mulv(R, d, x);
+            for (int k = 0; k < 3; ++k) x[k] += s->pose.pivot0[k] + b[k];
+            for (int k = 0; k < 3; ++k)
+                if (!(x[k] >= sc->domain_lo[k] && x[k] <= sc->domain_hi[k])) {
+                    st = mpm_error(MPM_EINPUT,
+                                   "%s: %s.shape: the source's bounds reach (%g, %g, %g), outside the domain "
+                                   "[%g, %g, %g]-[%g, %g, %g]",
+                                   file, p, x[0], x[1], x[2], sc->domain_lo[0], sc->domain_lo[1], sc->domain_lo[2],
+                                   sc->domain_hi[0], sc->domain_hi[1], sc->domain_hi[2]);
+                    break;
+                }
+        }
+    }
+    poisson_tile_free(own);
+    return st;
+}
+
 /* ======================================================================
  * Top level
  * ====================================================================== */
@@ -514,7 +649,7 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
     static const char *const keys[] = {"name",       "description", "dx",     "fps",          "frames",
                                        "cfl",        "max_dt",      "gravity", "apic_ratio",  "domain",
                                        "domain_walls", "seed",      "materials", "objects",   "colliders",
-                                       NULL};
+                                       "sources",    NULL};
     int st = sj_check_object(root, file, "", keys);
     if (st) return st;
     if ((st = read_name(root, "name", 1, file, "", sc->name, sizeof sc->name))) return st;
@@ -587,15 +722,19 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
     /* objects */
     json_t *objs = json_object_get(root, "objects");
     if (!objs) return mpm_error(MPM_EINPUT, "%s: objects: missing required field", file);
-    if (!json_is_array(objs) || json_array_size(objs) == 0)
-        return sj_bad(file, "", "objects", "expected a non-empty array of objects", objs);
+    json_t *srcs = json_object_get(root, "sources");
+    if (srcs && (!json_is_array(srcs) || json_array_size(srcs) == 0))
+        return sj_bad(file, "", "sources", "expected a non-empty array of sources", srcs);
+    if (!json_is_array(objs) || (json_array_size(objs) == 0 && !srcs))
+        return sj_bad(file, "", "objects", "expected a non-empty array of objects (empty only with \"sources\")",
+                      objs);
     size_t nobj = json_array_size(objs);
-    ObjectSpec *spec = calloc(nobj, sizeof *spec);
+    ObjectSpec *spec = calloc(nobj ? nobj : 1, sizeof *spec);
     if (!spec) return mpm_error(MPM_EINTERNAL, "out of memory");
     for (size_t i = 0; i < nobj && !st; ++i) {
         char p[64];
         sj_path_index(p, sizeof p, "objects", i);
-        st = parse_object(json_array_get(objs, i), file, p, (uint64_t)i, sc, asset_dir, &spec[i]);
+        st = parse_object(json_array_get(objs, i), file, p, (uint64_t)i, sc, asset_dir, scale, &spec[i]);
     }
 
     /* colliders */
@@ -603,8 +742,8 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
     if (!st && cols && !json_is_array(cols))
         st = sj_bad(file, "", "colliders", "expected an array of colliders", cols);
     if (!st) {
-        size_t nc = cols ? json_array_size(cols) : 0;
-        sc->colliders = calloc(nc + 6, sizeof(Collider));
+        size_t nc = cols ? json_array_size(cols) : 0, ns = srcs ? json_array_size(srcs) : 0;
+        sc->colliders = calloc(nc + ns + 6, sizeof(Collider));
         if (!sc->colliders) st = mpm_error(MPM_EINTERNAL, "out of memory");
         for (size_t i = 0; i < nc && !st; ++i) {
             char p[64], defname[64];
@@ -614,6 +753,7 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
                                       &sc->colliders[sc->n_colliders]);
             if (!st) ++sc->n_colliders;
         }
+        if (!st && ns) st = parse_sources(sc, srcs, file, asset_dir);
         for (int a = 0; a < sc->n_colliders && !st; ++a)
             for (int b = 0; b < a; ++b)
                 if (strcmp(sc->colliders[a].name, sc->colliders[b].name) == 0) {
@@ -630,7 +770,10 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
         for (int k = 0; k < sc->n_materials; ++k) snow |= sc->materials[k].plasticity == PLASTICITY_SNOW;
         if (snow) st = particles_enable_plastic_state(&sc->particles);
     }
-    for (size_t i = 0; i < nobj; ++i) shape_free(spec[i].shape);
+    for (size_t i = 0; i < nobj; ++i) {
+        shape_free(spec[i].shape);
+        shape_free(spec[i].surf_mesh);
+    }
     free(spec);
     return st;
 }
@@ -729,6 +872,8 @@ int scene_load(const char *name_or_path, const SceneLoadOptions *opt, Scene *out
 void scene_free(Scene *s)
 {
     if (!s) return;
+    for (int k = 0; k < s->n_sources; ++k) source_free(&s->sources[k]);
+    free(s->sources);
     free(s->materials);
     for (int k = 0; k < s->n_colliders; ++k) collider_free(&s->colliders[k]);
     free(s->colliders);

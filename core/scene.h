@@ -36,7 +36,8 @@
  *                      "min_Jp": (default 0), "max_Jp": (default 1e30)}
  *     }, ...
  *   },
- *   "objects": [                      required, at least one
+ *   "objects": [                      required, at least one (may be empty
+ *                                     when the scene has "sources")
  *     {"name": "...",                 optional label
  *      "material": "NAME",            required, a key of "materials"
  *      "shape": {...},                required, see core/shape.h (must be bounded)
@@ -51,14 +52,35 @@
  *                                     per particle (default) or one for the
  *                                     whole object; seed defaults to one
  *                                     derived from the scene seed
+ *      "surface_particles": {"count": N} | {"vertices_of": {mesh shape}}
+ *                                     optional: extra particles on the
+ *                                     surface, standing in for the
+ *                                     reference's .obj vertices that it adds
+ *                                     as particles (hot-scenes.md 1.5).
+ *                                     "count": N points spread uniformly by
+ *                                     area over the shape's surface
+ *                                     (core/sampler.h sampler_surface);
+ *                                     "vertices_of": the vertices of that
+ *                                     mesh (transform applied). N (or the
+ *                                     vertex count) is for --scale 1: at
+ *                                     --scale s, round(N / s^3) are used
+ *                                     (evenly spaced vertices in file order),
+ *                                     so they keep their share of the count.
  *     }, ...
  *   ],
  *   "colliders": [ {...}, ... ]       optional, see core/collider.h
+ *   "sources": [ {...}, ... ]         optional, particle sources, see
+ *                                     core/source.h; each adds a sticky
+ *                                     collider after "colliders" (before
+ *                                     the domain walls) unless disabled
  * }
  *
  * Particles: each object is sampled independently (overlapping objects keep
  * both particle sets, as in the reference). Rest volume V_p = shape volume /
- * number of samples, mass = density V_p, C = 0, F = I unless initial_F.
+ * number of particles (interior samples plus surface particles, as the
+ * reference does for analytic shapes with .obj vertices), mass =
+ * density V_p, C = 0, F = I unless initial_F. Surface particles come first
+ * in each object (the reference prepends the vertices).
  *
  * Overrides (--set key=value) are applied to the JSON tree before validation.
  * The key is a dot path: object members by key, array elements by index
@@ -80,6 +102,7 @@
 #include "core/collider.h"
 #include "core/material.h"
 #include "core/particles.h"
+#include "core/source.h"
 
 typedef struct {
     const char *key;
@@ -105,8 +128,10 @@ typedef struct Scene {
     double domain_lo[3], domain_hi[3];
     Material *materials;              /* declaration order */
     int n_materials;
-    Collider *colliders;              /* scene colliders, then the domain walls */
+    Collider *colliders;              /* scene colliders, source colliders, then the domain walls */
     int n_colliders;
+    Source *sources;                  /* particle sources (core/source.h) */
+    int n_sources;
     Particles particles;              /* initial state */
     int needs_plasticity;             /* some material is plastic */
     unsigned long long seed;

@@ -631,6 +631,35 @@ double shape_volume(const Shape *s)
 
 const char *shape_type_name(const Shape *s) { return k_type_names[s->type]; }
 
+int shape_mesh_vertices(const Shape *s, double **xyz, size_t *n)
+{
+    *xyz = NULL;
+    *n = 0;
+    if (s->type != SH_MESH || !s->mesh)
+        return mpm_error(MPM_EINPUT, "expected a mesh shape, got a %s", k_type_names[s->type]);
+#if MPM_HAVE_MESH
+    size_t nv = (size_t)mesh_vertex_count(s->mesh);
+    const double *v = mesh_vertices(s->mesh);
+    double *out = malloc(sizeof(double) * 3 * (nv ? nv : 1));
+    if (!out) return mpm_error(MPM_EINTERNAL, "out of memory copying mesh vertices");
+    for (size_t k = 0; k < nv; ++k) {
+        /* x = pivot + t + s Rot (X - pivot) */
+        double d[3], e[3];
+        for (int c = 0; c < 3; ++c) d[c] = v[3 * k + c] - s->pivot[c];
+        if (s->has_rot)
+            m3_mulv(s->rot, d, e);
+        else
+            memcpy(e, d, sizeof e);
+        for (int c = 0; c < 3; ++c) out[3 * k + c] = s->has_xf ? s->pivot[c] + s->t[c] + s->s * e[c] : v[3 * k + c];
+    }
+    *xyz = out;
+    *n = nv;
+    return MPM_OK;
+#else
+    return mpm_error(MPM_EINPUT, "mesh shapes not available in this build");
+#endif
+}
+
 void shape_free(Shape *s)
 {
     if (!s) return;

@@ -77,6 +77,11 @@ int shape_is_bounded(const Shape *s);
  * unbounded. */
 double shape_volume(const Shape *s);
 
+/* For a "mesh" shape: copies of all its vertices (file order) in world
+ * coordinates, transform applied, as a malloc'ed array of 3 *n doubles
+ * (free it). MPM_EINPUT for other shape types. */
+int shape_mesh_vertices(const Shape *s, double **xyz, size_t *n);
+
 /* Type name as in JSON ("box", "union", ...). */
 const char *shape_type_name(const Shape *s);
 

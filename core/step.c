@@ -153,6 +153,10 @@ int step_end(Simulation *sim, const double *dv)
         int st = plasticity_apply(&sim->p, sc->materials, sc->n_materials);
         if (st) return st;
     }
+    if (sc->n_sources) { /* particle sources emit after the step [t, t + dt] (SPEC 2 item 8) */
+        int st = source_emit_all(sc->sources, sc->n_sources, &sim->p, sim->t, sim->dt);
+        if (st) return st;
+    }
     sim->t += sim->dt;
     sim->t_in_frame += sim->dt;
     if (sim->t_in_frame >= sim->frame_dt * (1.0 - 1e-12)) {

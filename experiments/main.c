@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "experiments/bench.h"
 #include "experiments/registry.h"
+#include "experiments/render_cmd.h"
 #include "experiments/run.h"
 
 #define MAX_LIST 64
@@ -19,7 +20,9 @@ static void usage(FILE *f)
             "  mpmbench run --scene NAME|FILE --solver NAME [--frames N] [--eps E] [--scale S] [--threads T]\n"
             "               [--out DIR] [--set key=value ...] [--solver-opt key=value ...] [--history]\n"
             "               [--particles DIR] [--asset-dir DIR] [--armijo] [--quiet]\n"
-            "  mpmbench bench spmv|assemble|p2g|all --scene NAME [--scale S] [--threads T] [--set key=value ...]\n");
+            "  mpmbench bench spmv|assemble|p2g|all --scene NAME [--scale S] [--threads T] [--set key=value ...]\n"
+            "  mpmbench render --scene NAME|FILE [--frame N] [--out FILE.png] [--solver NAME] [--scale S] [--set key=value ...]\n"
+            "               [--view front|side|top|iso] [--color material|speed] [--width W] [--height H] [--asset-dir DIR] [--threads T]\n");
 }
 
 static void print_scene(const char *name, const char *desc, void *ctx)
@@ -167,6 +170,7 @@ int main(int argc, char **argv)
     if (!strcmp(argv[1], "list")) st = cmd_list(argc, argv);
     else if (!strcmp(argv[1], "run")) st = cmd_run(argc, argv);
     else if (!strcmp(argv[1], "bench")) st = cmd_bench(argc, argv);
+    else if (!strcmp(argv[1], "render")) st = render_command(argc, argv);
     else st = mpm_error(MPM_EINPUT, "unknown command '%s' (see: mpmbench --help)", argv[1]);
     if (st) {
         fprintf(stderr, "mpmbench: error: %s\n", mpm_last_error());

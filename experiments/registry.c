@@ -4,7 +4,10 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "adapters/cholmod_direct.h"
+#include "adapters/hypre_amg.h"
 #include "solvers/jacobi.h"
+#include "solvers/mg/mg.h"
 #include "solvers/pcg_inverse.h"
 #include "solvers/sgs.h"
 
@@ -17,8 +20,20 @@ static const SolverPreset g_presets[] = {
      &inv_block_jacobi_ops, 1, ""},
     {"pn-sgs-pcg", "projected Newton, PCG preconditioned by one coloured symmetric block Gauss-Seidel sweep (HOT Table 3)",
      METHOD_PN, &inv_sgs_ops, 0, ""},
+    {"pn-mgpcg", "projected Newton, PCG preconditioned by one node-embedding Galerkin V-cycle, rebuilt every iteration (HOT PN-MGPCG)",
+     METHOD_PN, &inv_mg_linear_ops, 0, ""},
+    {"pn-amg-pcg", "projected Newton, PCG preconditioned by one hypre BoomerAMG V-cycle (algebraic baseline)", METHOD_PN,
+     &inv_boomeramg_ops, 0, ""},
+    {"pn-cholmod", "projected Newton with exact CHOLMOD Cholesky solves (exact-Newton reference)", METHOD_PN,
+     &inv_cholmod_ops, 0, ""},
+    {"hot", "L-BFGS, initial inverse = one linear-embedding Galerkin multigrid V-cycle built once per step (HOT)",
+     METHOD_LBFGS, &inv_mg_linear_ops, 0, ""},
+    {"hot-quadratic", "HOT with the quadratic embedding kernel", METHOD_LBFGS, &inv_mg_quadratic_ops, 0, ""},
     {"lbfgs-h", "L-BFGS, initial inverse = inexact block-Jacobi PCG on the start-of-step Hessian (HOT LBFGS-H)",
      METHOD_LBFGS, &inv_inexact_pcg_ops, 0, ""},
+    {"lbfgs-h-direct", "L-BFGS, initial inverse = CHOLMOD factor of the start-of-step Hessian (Li et al. 2019)",
+     METHOD_LBFGS, &inv_cholmod_ops, 0, ""},
+    {"lbfgs-amg", "L-BFGS, initial inverse = one hypre BoomerAMG V-cycle", METHOD_LBFGS, &inv_boomeramg_ops, 0, ""},
 };
 
 int registry_count(void) { return (int)(sizeof g_presets / sizeof g_presets[0]); }

@@ -29,7 +29,8 @@
 
 static int pcg_work_reserve(PcgWork *w, int n)
 {
-    if (n <= w->cap_nodes) return MPM_OK;
+    if (n <= w->cap_nodes && w->r) return MPM_OK;
+    if (n < 1) n = 1;
     size_t len = 3 * (size_t)n;
     double **arr[4] = {&w->r, &w->z, &w->p, &w->q};
     for (int k = 0; k < 4; ++k) {

@@ -136,7 +136,10 @@ static void test_stretched_box(void)
 {
     Scene s, s2;
     mpm_clear_error();
-    int st = scene_load("stretched-box", NULL, &s);
+    /* scale 2 (dx 0.02) and the per-particle variant of the initial F */
+    SceneOverride per = {"objects.0.initial_F.per_particle", "true"};
+    SceneLoadOptions lo = {2.0, &per, 1, NULL};
+    int st = scene_load("stretched-box", &lo, &s);
     CHECK(st == 0, "stretched-box: %s", mpm_last_error());
     if (st) return;
     printf("stretched-box: %zu particles\n", s.particles.n);
@@ -154,7 +157,7 @@ static void test_stretched_box(void)
     CHECK(ok && mn >= 0.7 && mx <= 1.3 && mn < 0.72 && mx > 1.28, "diagonal F in [0.7, 1.3]: %g %g", mn, mx);
     CHECK(distinct > (int)s.particles.n / 2, "per-particle F");
     CHECK(s.frames == 1 && s.gravity[1] == 0, "one frame, no gravity");
-    st = scene_load("stretched-box", NULL, &s2);
+    st = scene_load("stretched-box", &lo, &s2);
     CHECK(st == 0 && s2.particles.n == s.particles.n &&
               memcmp(s2.particles.F, s.particles.F, 9 * s.particles.n * sizeof(double)) == 0 &&
               memcmp(s2.particles.x, s.particles.x, 3 * s.particles.n * sizeof(double)) == 0,
