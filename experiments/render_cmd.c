@@ -157,8 +157,11 @@ static void grow(double lo[3], double hi[3], const double p[3])
  * surfaces near it; see render_cmd.h. Surface samples: the points of a
  * regular grid over the neighbourhood whose |phi| is within half a cell
  * diagonal (phi is a distance or a lower bound of one, so every surface
- * point near the grid has such a sample). */
-static int frame_colliders(const Scene *sc, double t, const int *idx, int n, double lo[3], double hi[3])
+ * point near the grid has such a sample).
+ * With `empty` set (no particles), the neighbourhood is the domain, [lo, hi]
+ * becomes the box of the bounded colliders' surfaces in it, and stays as it
+ * was (the domain) when there are none. */
+static int frame_colliders(const Scene *sc, double t, const int *idx, int n, int empty, double lo[3], double hi[3])
 {
     double plo[3], phi_[3], ext = 0;
     for (int d = 0; d < 3; ++d) {
@@ -167,20 +170,27 @@ static int frame_colliders(const Scene *sc, double t, const int *idx, int n, dou
         ext = fmax(ext, hi[d] - lo[d]);
     }
     if (!(ext > 0)) ext = 10 * sc->dx;
+    const double pad = empty ? 0.0 : ext;
     const int G = RC_FRAME_SAMPLES;
     double nlo[3], cell[3], diag = 0;
     for (int d = 0; d < 3; ++d) {
-        nlo[d] = plo[d] - ext;
-        cell[d] = (phi_[d] - plo[d] + 2 * ext) / (G - 1);
+        nlo[d] = plo[d] - pad;
+        cell[d] = (phi_[d] - plo[d] + 2 * pad) / (G - 1);
         diag += cell[d] * cell[d];
     }
     double tol = 0.5 * sqrt(diag);
     size_t npts = (size_t)G * G * G;
     double *dist = malloc(npts * sizeof *dist); /* distance to the particle box of surface samples, else -1 */
     if (!dist) return mpm_error(MPM_EINTERNAL, "render: out of memory framing colliders");
+    double glo[3] = {INFINITY, INFINITY, INFINITY}, ghi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    if (!empty) {
+        memcpy(glo, plo, sizeof glo);
+        memcpy(ghi, phi_, sizeof ghi);
+    }
     for (int c = 0; c < n; ++c) {
         const Collider *col = &sc->colliders[idx[c]];
         int bounded = shape_is_bounded(col->shape);
+        if (empty && !bounded) continue;
         double dmin = INFINITY;
 #pragma omp parallel for reduction(min : dmin) schedule(static)
         for (long k = 0; k < (long)npts; ++k) {
@@ -199,10 +209,14 @@ static int frame_colliders(const Scene *sc, double t, const int *idx, int n, dou
             if (dist[k] < 0 || dist[k] > limit) continue;
             double p[3] = {nlo[0] + cell[0] * (double)(k % G), nlo[1] + cell[1] * (double)((k / G) % G),
                            nlo[2] + cell[2] * (double)(k / ((size_t)G * G))};
-            grow(lo, hi, p);
+            grow(glo, ghi, p);
         }
     }
     free(dist);
+    if (glo[0] <= ghi[0]) {
+        memcpy(lo, glo, sizeof glo);
+        memcpy(hi, ghi, sizeof ghi);
+    }
     return MPM_OK;
 }
 
@@ -343,12 +357,11 @@ static int render_state(const RenderArgs *a, const Scene *sc, const Particles *p
         ++n_finite;
         grow(lo, hi, x);
     }
-    if (n_finite == 0) { /* nothing left to look at: show the domain */
+    if (n_finite == 0) { /* no particles (yet): the colliders in the domain, else the domain */
         memcpy(lo, sc->domain_lo, sizeof lo);
         memcpy(hi, sc->domain_hi, sizeof hi);
-    } else if (n_draw > 0 && (status = frame_colliders(sc, t, idx, n_draw, lo, hi))) {
-        goto done;
     }
+    if (n_draw > 0 && (status = frame_colliders(sc, t, idx, n_draw, n_finite == 0, lo, hi))) goto done;
     double ext = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
     if (!(ext > 0)) ext = 10 * sc->dx;
     for (int d = 0; d < 3; ++d) {

@@ -26,7 +26,9 @@
  * extent of the particles' box, and for unbounded ones (a ground) only the
  * part of the surface nearest to the particles (within 10% of the extent
  * of the nearest distance), so a ground plane adds a strip below the
- * particles, not an infinite floor; then a 10% margin.
+ * particles, not an infinite floor; then a 10% margin. A state without
+ * particles (a scene filled by a source later) frames the bounded colliders
+ * in the domain, or the domain when there are none.
  *
  * Returns MPM_OK, MPM_EINPUT (one-line message) for bad flags or input,
  * MPM_EINTERNAL otherwise. */
