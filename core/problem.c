@@ -640,6 +640,22 @@ void problem_diagonal(StepProblem *pb, double *D)
     }
 }
 
+void problem_mark_dirichlet(StepProblem *pb, DirichletFn fn, const void *ctx)
+{
+    pb->dirichlet_fn = fn;
+    pb->dirichlet_ctx = ctx;
+    if (fn) {
+        const Grid *g = pb->grid;
+        double dx = g->dx;
+#pragma omp parallel for schedule(dynamic, 256)
+        for (int i = 0; i < g->n; ++i) {
+            double x[3] = {g->coord[3 * i] * dx, g->coord[3 * i + 1] * dx, g->coord[3 * i + 2] * dx};
+            fn(ctx, pb, i, x);
+        }
+    }
+    problem_finish_dirichlet(pb);
+}
+
 void problem_finish_dirichlet(StepProblem *pb)
 {
     int count = 0;

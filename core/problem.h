@@ -29,6 +29,13 @@
 
 enum { BC_FREE = 0, BC_STICKY = 1, BC_SLIP = 2 };
 
+struct StepProblem;
+/* Decides whether the node at world position x is constrained and, if so,
+ * calls problem_set_dirichlet for it (the step driver tests colliders). Kept
+ * in the problem so coarse grids (geometric multigrid) can ask the same
+ * question at their own nodes. Must be safe to call concurrently. */
+typedef void (*DirichletFn)(const void *ctx, struct StepProblem *pb, int node, const double x[3]);
+
 typedef struct StepProblem {
     int n_nodes;
     size_t n_particles;
@@ -51,6 +58,8 @@ typedef struct StepProblem {
     double *kappa;       /* per node: 24 dx^2 dt abar_i (SPEC 4, without eps) */
     double max_stiffness;/* max_p a_p this step */
     int n_dirichlet;
+    DirichletFn dirichlet_fn; /* NULL: no constraints */
+    const void *dirichlet_ctx;
 
     /* iterate cache */
     double *F, *P;       /* 9 per particle at the last problem_energy point */
@@ -80,6 +89,8 @@ int problem_prepare(StepProblem *pb, const Grid *g, const Stencils *st, const Pa
  * slip fixes the normal component only: P_i = I - n n^T. Several slip calls
  * on one node are combined (normals Gram-Schmidt'ed); sticky wins. */
 void problem_set_dirichlet(StepProblem *pb, int node, const double v_target[3], const double normal[3]);
+/* Marks every node with fn (in parallel over nodes) and remembers fn, ctx. */
+void problem_mark_dirichlet(StepProblem *pb, DirichletFn fn, const void *ctx);
 /* Counts the constrained nodes; call once after the last problem_set_dirichlet
  * (problem_set_dirichlet touches only its node, so callers may run it in
  * parallel over nodes). */

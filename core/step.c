@@ -83,41 +83,32 @@ double sim_next_dt(const Simulation *sim)
     return dt;
 }
 
-/* Dirichlet nodes from colliders posed at t^n (SPEC 2 item 3). */
-static void mark_dirichlet(Simulation *sim)
+/* Dirichlet nodes from colliders posed at t^n (SPEC 2 item 3): sticky wins,
+ * slip colliders add their normals. Called per node, possibly concurrently. */
+static void collider_dirichlet(const void *ctx, StepProblem *pb, int i, const double x[3])
 {
+    const Simulation *sim = ctx;
     const Scene *sc = sim->scene;
-    if (sc->n_colliders == 0) return;
-    Grid *g = &sim->grid;
-    StepProblem *pb = &sim->pb;
-    double dx = g->dx, t = sim->t;
-    /* node-parallel: each node only writes its own entries */
-#pragma omp parallel for schedule(dynamic, 256)
-    for (int i = 0; i < g->n; ++i) {
-        double x[3] = {g->coord[3 * i] * dx, g->coord[3 * i + 1] * dx, g->coord[3 * i + 2] * dx};
-        int sticky = -1;
-        for (int c = 0; c < sc->n_colliders && sticky < 0; ++c) {
-            const Collider *col = &sc->colliders[c];
-            if (col->kind != COLLIDER_STICKY || !collider_active(col, t)) continue;
-            if (collider_phi(col, t, x, NULL) <= 0.0) sticky = c;
-        }
-        if (sticky >= 0) {
-            double v[3];
-            collider_velocity(&sc->colliders[sticky], t, x, v);
-            problem_set_dirichlet(pb, i, v, NULL);
-            continue;
-        }
-        for (int c = 0; c < sc->n_colliders; ++c) {
-            const Collider *col = &sc->colliders[c];
-            if (col->kind != COLLIDER_SLIP || !collider_active(col, t)) continue;
-            double nrm[3];
-            if (collider_phi(col, t, x, nrm) > 0.0) continue;
+    double t = sim->t;
+    for (int c = 0; c < sc->n_colliders; ++c) {
+        const Collider *col = &sc->colliders[c];
+        if (col->kind != COLLIDER_STICKY || !collider_active(col, t)) continue;
+        if (collider_phi(col, t, x, NULL) <= 0.0) {
             double v[3];
             collider_velocity(col, t, x, v);
-            problem_set_dirichlet(pb, i, v, nrm);
+            problem_set_dirichlet(pb, i, v, NULL);
+            return;
         }
     }
-    problem_finish_dirichlet(pb);
+    for (int c = 0; c < sc->n_colliders; ++c) {
+        const Collider *col = &sc->colliders[c];
+        if (col->kind != COLLIDER_SLIP || !collider_active(col, t)) continue;
+        double nrm[3];
+        if (collider_phi(col, t, x, nrm) > 0.0) continue;
+        double v[3];
+        collider_velocity(col, t, x, v);
+        problem_set_dirichlet(pb, i, v, nrm);
+    }
 }
 
 int step_begin(Simulation *sim)
@@ -130,7 +121,7 @@ int step_begin(Simulation *sim)
     if ((st = problem_prepare(&sim->pb, &sim->grid, &sim->st, &sim->p, sc->materials, sc->n_materials, sim->dt,
                               sc->gravity)))
         return st;
-    mark_dirichlet(sim);
+    problem_mark_dirichlet(&sim->pb, sc->n_colliders ? collider_dirichlet : NULL, sim);
     return MPM_OK;
 }
 

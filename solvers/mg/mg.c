@@ -11,6 +11,7 @@
 #include "core/vec.h"
 #include "solvers/jacobi.h"
 #include "solvers/mg/galerkin.h"
+#include "solvers/mg/gmg_level.h"
 #include "solvers/mg/transfer.h"
 #include "solvers/pcg.h"
 #include "solvers/sgs.h"
@@ -48,6 +49,8 @@ typedef struct {
     MgGalerkinWork *gw;
     CoarseJacobi cj;
     MgInfo info;
+    int rediscretize;            /* baseline GMG: coarse levels from particles */
+    GmgLevel gl[MG_MAX_LEVELS];  /* their particle copies and grids */
 } Mg;
 
 static int cj_apply(InvApprox *self, const double *r, double *z)
@@ -103,7 +106,7 @@ static int level_reserve(MgLevel *L, int n, int own_diag)
     return MPM_OK;
 }
 
-static int mg_create(MgEmbedding kind, const SolverOptions *opt, InvApprox **out)
+static int mg_create(MgEmbedding kind, int rediscretize, const SolverOptions *opt, InvApprox **out)
 {
     int st = MPM_OK;
     double levels = solver_opt_number(opt, "levels", 3, &st);
@@ -124,8 +127,9 @@ static int mg_create(MgEmbedding kind, const SolverOptions *opt, InvApprox **out
         return mpm_error(MPM_EINPUT, "--solver-opt coarse_max_iters=%g: expected a positive integer", cmax);
     Mg *M = calloc(1, sizeof *M);
     if (!M) return mpm_error(MPM_EINTERNAL, "out of memory: multigrid");
-    M->base.ops = kind == MG_EMBED_LINEAR ? &inv_mg_linear_ops : &inv_mg_quadratic_ops;
+    M->base.ops = rediscretize ? &inv_gmg_ops : kind == MG_EMBED_LINEAR ? &inv_mg_linear_ops : &inv_mg_quadratic_ops;
     M->kind = kind;
+    M->rediscretize = rediscretize;
     M->max_levels = (int)levels;
     M->sweeps = (int)sweeps;
     M->min_coarse = (int)minc;
@@ -136,11 +140,15 @@ static int mg_create(MgEmbedding kind, const SolverOptions *opt, InvApprox **out
     return MPM_OK;
 }
 
-static int mg_linear_create(const SolverOptions *opt, InvApprox **out) { return mg_create(MG_EMBED_LINEAR, opt, out); }
+static int mg_linear_create(const SolverOptions *opt, InvApprox **out)
+{
+    return mg_create(MG_EMBED_LINEAR, 0, opt, out);
+}
 static int mg_quadratic_create(const SolverOptions *opt, InvApprox **out)
 {
-    return mg_create(MG_EMBED_QUADRATIC, opt, out);
+    return mg_create(MG_EMBED_QUADRATIC, 0, opt, out);
 }
+static int gmg_create(const SolverOptions *opt, InvApprox **out) { return mg_create(MG_EMBED_LINEAR, 1, opt, out); }
 
 static void fill_level_info(Mg *M, int l)
 {
@@ -186,7 +194,16 @@ static int mg_setup(InvApprox *self, const InvSetupInput *in)
     while (nl < M->max_levels && M->lev[nl - 1].n >= M->min_coarse) {
         MgLevel *F = &M->lev[nl - 1], *C = &M->lev[nl];
         double ta = omp_get_wtime();
-        if ((st = mg_transfer_build(&F->T, M->kind, F->coord, F->n))) return st;
+        if (M->rediscretize) {
+            /* baseline GMG: the level's own grid and Hessian from the
+             * particles at spacing 2^l dx, linear transfers onto it */
+            if (!in->problem) return mpm_error(MPM_EINTERNAL, "geometric multigrid needs the step problem");
+            double h = in->problem->dx * (double)(1 << nl);
+            if ((st = gmg_level_build(&M->gl[nl], in->problem, h, &C->Aown))) return st;
+            if ((st = gmg_transfer_onto(&F->T, F->coord, F->n, &M->gl[nl].grid))) return st;
+        } else if ((st = mg_transfer_build(&F->T, M->kind, F->coord, F->n))) {
+            return st;
+        }
         double tb = omp_get_wtime();
         M->info.transfer_s += tb - ta;
         int m = F->T.n_coarse;
@@ -194,7 +211,7 @@ static int mg_setup(InvApprox *self, const InvSetupInput *in)
         if ((st = level_reserve(C, m, 1))) return st;
         C->n = m;
         C->coord = F->T.coarse_coord;
-        if ((st = mg_galerkin(F->A, &F->T, &C->Aown, &M->gw))) return st;
+        if (!M->rediscretize && (st = mg_galerkin(F->A, &F->T, &C->Aown, &M->gw))) return st;
         C->A = &C->Aown;
         double tc = omp_get_wtime();
         M->info.galerkin_s += tc - tb;
@@ -317,6 +334,7 @@ static void mg_destroy(InvApprox *self)
         free(L->u);
         free(L->d);
         free(L->work);
+        gmg_level_free(&M->gl[l]);
     }
     pcg_work_free(&M->pw);
     mg_galerkin_work_free(M->gw);
@@ -325,7 +343,7 @@ static void mg_destroy(InvApprox *self)
 
 int mg_get_info(const InvApprox *self, MgInfo *info)
 {
-    if (!self || (self->ops != &inv_mg_linear_ops && self->ops != &inv_mg_quadratic_ops))
+    if (!self || (self->ops != &inv_mg_linear_ops && self->ops != &inv_mg_quadratic_ops && self->ops != &inv_gmg_ops))
         return mpm_error(MPM_EINTERNAL, "mg_get_info: not a multigrid inverse approximation");
     *info = ((const Mg *)self)->info;
     return MPM_OK;
@@ -347,3 +365,4 @@ void mg_print_info(const MgInfo *info, FILE *f)
 
 const InvApproxOps inv_mg_linear_ops = {"mg-linear", mg_linear_create, mg_setup, mg_apply, mg_destroy};
 const InvApproxOps inv_mg_quadratic_ops = {"mg-quadratic", mg_quadratic_create, mg_setup, mg_apply, mg_destroy};
+const InvApproxOps inv_gmg_ops = {"gmg", gmg_create, mg_setup, mg_apply, mg_destroy};

@@ -35,6 +35,11 @@
 
 extern const InvApproxOps inv_mg_linear_ops;    /* "mg-linear": HOT, PN-MGPCG */
 extern const InvApproxOps inv_mg_quadratic_ops; /* "mg-quadratic": HOT-quadratic */
+/* "gmg": the baseline geometric multigrid of SPEC 6 (LBFGS-GMG, PN-GMG-PCG):
+ * the same V-cycle, but every coarse level is rediscretised from the
+ * particles at spacing 2^l dx (mg/gmg_level.h) instead of R A P; needs
+ * InvSetupInput.problem with a current tangent. */
+extern const InvApproxOps inv_gmg_ops;
 
 typedef struct {
     int n_levels;
