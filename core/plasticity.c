@@ -113,7 +113,8 @@ int plasticity_apply(Particles *p, const Material *mats, int n_mats)
                                  "plasticity_apply: material %d (%s): snow needs 0 <= theta_c < 1 and "
                                  "theta_s >= 0 (theta_c %g, theta_s %g)",
                                  m, mt->name, mt->theta_c, mt->theta_s);
-            any_plastic = need_jp = 1;
+            any_plastic = 1;
+            if (mt->hardening != 0.0) need_jp = 1; /* without hardening Jp is never read */
             break;
         default:
             return mpm_error(MPM_EINTERNAL, "plasticity_apply: material %d (%s): unknown plasticity kind %d",
@@ -121,7 +122,7 @@ int plasticity_apply(Particles *p, const Material *mats, int n_mats)
         }
     }
     if (need_jp && !p->Jp)
-        return mpm_error(MPM_EINTERNAL, "plasticity_apply: snow plasticity needs the plastic state p->Jp "
+        return mpm_error(MPM_EINTERNAL, "plasticity_apply: snow hardening needs the plastic state p->Jp "
                                         "(particles_enable_plastic_state)");
 
     const long long n = (long long)p->n;
@@ -142,8 +143,10 @@ int plasticity_apply(Particles *p, const Material *mats, int n_mats)
         double *F = Fall + 9 * i;
         if (mt->plasticity == PLASTICITY_VON_MISES)
             plasticity_von_mises(F, mt->mu, mt->lambda, mt->yield_stress);
-        else if (mt->plasticity == PLASTICITY_SNOW)
-            plasticity_snow(F, &Jp[i], mt->theta_c, mt->theta_s, mt->min_Jp, mt->max_Jp);
+        else if (mt->plasticity == PLASTICITY_SNOW) {
+            double unused = 1.0;
+            plasticity_snow(F, Jp ? &Jp[i] : &unused, mt->theta_c, mt->theta_s, mt->min_Jp, mt->max_Jp);
+        }
     }
     return MPM_OK;
 }

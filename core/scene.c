@@ -767,8 +767,9 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
     if (!st) st = sample_objects(sc, file, spec, (int)nobj);
     if (!st && sc->needs_plasticity) {
         int snow = 0;
-        for (int k = 0; k < sc->n_materials; ++k) snow |= sc->materials[k].plasticity == PLASTICITY_SNOW;
-        if (snow) st = particles_enable_plastic_state(&sc->particles);
+        for (int k = 0; k < sc->n_materials; ++k)
+            snow |= sc->materials[k].plasticity == PLASTICITY_SNOW && sc->materials[k].hardening != 0.0;
+        if (snow) st = particles_enable_plastic_state(&sc->particles); /* only hardening reads Jp */
     }
     for (size_t i = 0; i < nobj; ++i) {
         shape_free(spec[i].shape);

@@ -746,6 +746,18 @@ static int parse_mesh(json_t *j, const char *file, const char *path, const char 
         snprintf(full, sizeof full, "%s", fname);
     else
         snprintf(full, sizeof full, "%s/%s", asset_dir, fname);
+    FILE *probe = fopen(full, "rb");
+    if (!probe) {
+        char p[512];
+        sj_path(p, sizeof p, path, "file");
+        if (fname[0] == '/' || !asset_dir || !asset_dir[0])
+            return mpm_error(MPM_EINPUT, "%s: %s: mesh file %s not found", file, p, full);
+        return mpm_error(MPM_EINPUT,
+                         "%s: %s: mesh file \"%s\" not found in the asset directory %s (looked for %s; pass "
+                         "--asset-dir DIR with the directory that holds it)",
+                         file, p, fname, asset_dir, full);
+    }
+    fclose(probe);
     if (have_mbe && mbe > 0)
         st = mesh_load_obj_lenient(full, (int)mbe, &s->mesh);
     else

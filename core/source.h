@@ -55,7 +55,9 @@
  * "material_velocity" = velocity (so grid nodes inside move with the
  * source's motion plus the outflow velocity) and "cfl_speed" = |velocity|
  * (the reference's source reports only its material speed to the CFL
- * rule). It stays in place after the emission window, as in the reference. */
+ * rule). It stays in place after the emission window, as in the reference.
+ * A source without a collider reports no speed to the CFL rule (its emitted
+ * particles do, once they exist). */
 #ifndef MPM_SOURCE_H
 #define MPM_SOURCE_H
 

@@ -34,7 +34,12 @@ int sim_init(Simulation *sim, const Scene *scene)
     sim->frame_dt = 1.0 / scene->fps;
     int st = copy_particles(&sim->p, &scene->particles);
     if (st) return st;
-    if (scene->needs_plasticity && (st = particles_enable_plastic_state(&sim->p))) return st;
+    /* per-particle plastic state only where a material reads it (snow hardening) */
+    for (int m = 0; m < scene->n_materials; ++m) {
+        const Material *mt = &scene->materials[m];
+        if (mt->plasticity == PLASTICITY_SNOW && mt->hardening != 0.0 && (st = particles_enable_plastic_state(&sim->p)))
+            return st;
+    }
     return MPM_OK;
 }
 

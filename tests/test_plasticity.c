@@ -235,11 +235,14 @@ static void test_apply(void)
     }
     memcpy(F0, p.F, sizeof(double) * 9 * n);
 
-    /* Snow without plastic state: error, nothing changed. */
+    /* Snow hardening without plastic state: error, nothing changed. (Without
+     * hardening Jp is never read, so no storage is needed.) */
+    mats[2].hardening = 10;
     mpm_clear_error();
-    CHECK(plasticity_apply(&p, mats, 3) == MPM_EINTERNAL, "snow without Jp must fail");
+    CHECK(plasticity_apply(&p, mats, 3) == MPM_EINTERNAL, "snow hardening without Jp must fail");
     CHECK(strlen(mpm_last_error()) > 0, "error message recorded");
     CHECK(memcmp(F0, p.F, sizeof(double) * 9 * n) == 0, "failed apply changed F");
+    mats[2].hardening = 0;
 
     CHECK(particles_enable_plastic_state(&p) == MPM_OK, "enable Jp");
     /* Bad material index: error, nothing changed. */

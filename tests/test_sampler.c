@@ -1,6 +1,7 @@
 /* Samplers: Poisson minimum distance (tile and cut, across tile seams),
  * realised density 0.868 ppc per dx^3 within 5%, determinism for a seed,
- * random and lattice counts, bad input, and the speed of a ~1e6 cut. */
+ * random and lattice counts, surface points (on the surface, spread by
+ * area), bad input, and the speed of a ~1e6 cut. */
 #include <jansson.h>
 #include <math.h>
 #include <omp.h>
@@ -224,6 +225,86 @@ static void test_speed(const PoissonTile *t)
     shape_free(box);
 }
 
+/* Surface points: on the surface, spread by area (sphere octants, box
+ * faces), deterministic, CSG interior surfaces excluded. */
+static void test_surface(void)
+{
+    Shape *sph = make("{\"type\":\"sphere\",\"center\":[0.3,0.2,0.1],\"radius\":0.25}");
+    Shape *box = make("{\"type\":\"box\",\"min\":[0,0,0],\"max\":[0.4,0.2,0.1]}");
+    Shape *uni = make("{\"type\":\"union\",\"shapes\":[{\"type\":\"sphere\",\"center\":[0,0,0],\"radius\":0.2},"
+                      "{\"type\":\"sphere\",\"center\":[0.2,0,0],\"radius\":0.2}]}");
+    if (!sph || !box || !uni) {
+        CHECK(0, "surface test shapes");
+        shape_free(sph), shape_free(box), shape_free(uni);
+        return;
+    }
+    const size_t N = 40000;
+    SamplePoints a = {0}, b = {0};
+    double h = 0.01;
+    mpm_clear_error();
+    CHECK(sampler_surface(sph, N, h, 5, &a) == 0 && a.n == N, "sphere: %zu points (%s)", a.n, mpm_last_error());
+    double worst = 0;
+    size_t oct[8] = {0};
+    for (size_t k = 0; k < a.n; ++k) {
+        double d[3] = {a.x[3 * k] - 0.3, a.x[3 * k + 1] - 0.2, a.x[3 * k + 2] - 0.1};
+        worst = fmax(worst, fabs(sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - 0.25));
+        oct[(d[0] > 0) + 2 * (d[1] > 0) + 4 * (d[2] > 0)]++;
+    }
+    CHECK(worst < 1e-3 * h, "sphere points on the surface (max |r - R| %.2e)", worst);
+    int oct_ok = 1;
+    for (int o = 0; o < 8; ++o)
+        if (fabs((double)oct[o] / (N / 8.0) - 1) > 0.05) oct_ok = 0;
+    CHECK(oct_ok, "sphere octants equal within 5%%: %zu %zu %zu %zu %zu %zu %zu %zu", oct[0], oct[1], oct[2], oct[3],
+          oct[4], oct[5], oct[6], oct[7]);
+    CHECK(sampler_surface(sph, N, h, 5, &b) == 0 && b.n == a.n && memcmp(a.x, b.x, 3 * a.n * sizeof(double)) == 0,
+          "deterministic for a seed");
+    sample_points_free(&a);
+    sample_points_free(&b);
+
+    /* box: faces get points in proportion to their areas (0.08, 0.04, 0.02 m^2
+     * pairs), up to the edges' share ~ h edge length / area */
+    memset(&a, 0, sizeof a);
+    CHECK(sampler_surface(box, N, 0.002, 9, &a) == 0 && a.n == N, "box points");
+    size_t face[3] = {0, 0, 0}, off = 0;
+    const double ext[3] = {0.4, 0.2, 0.1};
+    for (size_t k = 0; k < a.n; ++k) {
+        int hit = -1;
+        for (int d = 0; d < 3; ++d) {
+            double x = a.x[3 * k + d];
+            if (fabs(x) < 1e-6 || fabs(x - ext[d]) < 1e-6) hit = d;
+        }
+        if (hit < 0) ++off;
+        else ++face[hit];
+    }
+    double area[3] = {2 * 0.2 * 0.1, 2 * 0.4 * 0.1, 2 * 0.4 * 0.2}, tot = area[0] + area[1] + area[2];
+    CHECK(off == 0, "box points on faces (%zu off)", off);
+    for (int d = 0; d < 3; ++d)
+        CHECK(fabs(face[d] / (N * area[d] / tot) - 1) < 0.05, "box face pair %d: %zu points, expected %.0f", d, face[d],
+              N * area[d] / tot);
+    sample_points_free(&a);
+
+    /* union of two spheres: nothing on the hidden inner caps */
+    memset(&a, 0, sizeof a);
+    CHECK(sampler_surface(uni, 5000, h, 3, &a) == 0 && a.n == 5000, "union points");
+    size_t hidden = 0;
+    for (size_t k = 0; k < a.n; ++k) {
+        const double *x = a.x + 3 * k;
+        double r0 = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+        double r1 = sqrt((x[0] - 0.2) * (x[0] - 0.2) + x[1] * x[1] + x[2] * x[2]);
+        if (r0 < 0.2 - 1e-4 || r1 < 0.2 - 1e-4) ++hidden;
+    }
+    CHECK(hidden == 0, "union: %zu points inside the other sphere", hidden);
+    sample_points_free(&a);
+
+    /* bad input */
+    memset(&a, 0, sizeof a);
+    mpm_clear_error();
+    CHECK(sampler_surface(sph, 10, 0.0, 1, &a) == MPM_EINPUT, "h = 0 rejected");
+    shape_free(sph);
+    shape_free(box);
+    shape_free(uni);
+}
+
 int main(void)
 {
     double t0 = omp_get_wtime();
@@ -234,6 +315,7 @@ int main(void)
     test_tile(t);
     test_poisson(t);
     test_random_lattice();
+    test_surface();
     test_speed(t);
     poisson_tile_free(t);
     return test_summary("test_sampler");

@@ -15,14 +15,14 @@
 static double now(void) { return omp_get_wtime(); }
 
 typedef struct {
-    char names[16][64];
+    char names[64][64];
     int n;
 } Listing;
 
 static void on_scene(const char *name, const char *desc, void *ctx)
 {
     Listing *l = ctx;
-    if (l->n < 16) snprintf(l->names[l->n++], 64, "%s", name);
+    if (l->n < 64) snprintf(l->names[l->n++], 64, "%s", name);
     (void)desc;
 }
 
