@@ -13,6 +13,7 @@
 #include "experiments/ply.h"
 #include "experiments/progress.h"
 #include "experiments/registry.h"
+#include "solvers/mg/mg.h"
 #include "solvers/solver.h"
 
 void run_config_default(RunConfig *c)
@@ -207,6 +208,17 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
                sum->frames, sum->steps, sum->outer_iters, sum->linear_iters, sum->wall_s,
                sum->frames ? sum->wall_s / sum->frames : 0.0, solve_status_name((SolveStatus)sum->worst_status));
         printf("wrote %s/steps.csv and %s/frames.csv%s\n", out_dir, out_dir, iters_csv ? " and iters.csv" : "");
+    }
+    /* multigrid solvers: the hierarchy of the last setup (HOT Fig. 8: blocks per row per level) */
+    MgInfo mgi;
+    if (!status && mg_is_multigrid(solver->inv) && mg_get_info(solver->inv, &mgi) == MPM_OK) {
+        if (!cfg->quiet) mg_print_info(&mgi, stdout);
+        FILE *lv = open_in(out_dir, "mg_levels.csv", &status);
+        if (!lv) goto done;
+        fprintf(lv, "level,nodes,blocks,blocks_per_row_avg,blocks_per_row_max\n");
+        for (int l = 0; l < mgi.n_levels; ++l)
+            fprintf(lv, "%d,%d,%lld,%.2f,%d\n", l, mgi.n[l], (long long)mgi.nnzb[l], mgi.avg_row[l], mgi.max_row[l]);
+        fclose(lv);
     }
 done:
     if (steps_csv) fclose(steps_csv);

@@ -6,7 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(build-essential cmake pkg-config libhypre-dev libsuitesparse-dev libgsl-dev
-          libopenmpi-dev openmpi-bin libjansson-dev libpng-dev)
+          libopenmpi-dev openmpi-bin libjansson-dev libpng-dev libopenblas0)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -171,6 +171,7 @@ static int mg_setup(InvApprox *self, const InvSetupInput *in)
     self->stats = (InvStats){0};
     memset(&M->info, 0, sizeof M->info);
     M->info.embedding = (int)M->kind;
+    M->info.rediscretized = M->rediscretize;
     M->nlev = 0;
     if (!in->H) return mpm_error(MPM_EINPUT, "multigrid needs an assembled matrix (not available matrix-free)");
     if (!in->coord || !in->coloring || !in->diag)
@@ -341,6 +342,11 @@ static void mg_destroy(InvApprox *self)
     free(M);
 }
 
+int mg_is_multigrid(const InvApprox *self)
+{
+    return self && (self->ops == &inv_mg_linear_ops || self->ops == &inv_mg_quadratic_ops || self->ops == &inv_gmg_ops);
+}
+
 int mg_get_info(const InvApprox *self, MgInfo *info)
 {
     if (!self || (self->ops != &inv_mg_linear_ops && self->ops != &inv_mg_quadratic_ops && self->ops != &inv_gmg_ops))
@@ -351,8 +357,10 @@ int mg_get_info(const InvApprox *self, MgInfo *info)
 
 void mg_print_info(const MgInfo *info, FILE *f)
 {
-    fprintf(f, "multigrid (%s embedding): %d levels, setup %.4f s (transfer %.4f, galerkin %.4f, diagonal %.4f)\n",
-            info->embedding == MG_EMBED_LINEAR ? "linear" : "quadratic", info->n_levels, info->setup_s,
+    fprintf(f, "multigrid (%s): %d levels, setup %.4f s (transfer %.4f, galerkin %.4f, diagonal %.4f)\n",
+            info->rediscretized ? "geometric, rediscretised from particles"
+            : info->embedding == MG_EMBED_LINEAR ? "linear embedding" : "quadratic embedding",
+            info->n_levels, info->setup_s,
             info->transfer_s, info->galerkin_s, info->diag_s);
     for (int l = 0; l < info->n_levels; ++l)
         fprintf(f, "  level %d: %8d nodes %10lld blocks  blocks/row avg %6.1f max %4d  smooth %.4f s\n", l, info->n[l],

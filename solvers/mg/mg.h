@@ -44,6 +44,7 @@ extern const InvApproxOps inv_gmg_ops;
 typedef struct {
     int n_levels;
     int embedding; /* MgEmbedding */
+    int rediscretized; /* baseline GMG */
     int n[MG_MAX_LEVELS];              /* nodes per level */
     int64_t nnzb[MG_MAX_LEVELS];       /* stored blocks per level */
     double avg_row[MG_MAX_LEVELS];     /* nonzero blocks per row, mean */
@@ -55,6 +56,8 @@ typedef struct {
     double transfer_apply_s, coarse_s;
 } MgInfo;
 
+/* Non-zero when self is one of the multigrid inverse approximations. */
+int mg_is_multigrid(const InvApprox *self);
 /* Fills info for an InvApprox created from one of the two tables above
  * (MPM_EINTERNAL for any other). */
 int mg_get_info(const InvApprox *self, MgInfo *info);
