@@ -123,6 +123,17 @@ static int is_domain_wall(const Collider *c)
     return 0;
 }
 
+/* Vertical half-spaces (side walls, e.g. Boxes and Boards) would cover the
+ * whole picture as huge planes: only floors (normal near +-y) are drawn. */
+static int is_side_wall(const Scene *sc, const Collider *c, double t)
+{
+    if (strcmp(shape_type_name(c->shape), "half_space")) return 0;
+    double x[3], n[3] = {0, 1, 0};
+    for (int d = 0; d < 3; ++d) x[d] = 0.5 * (sc->domain_lo[d] + sc->domain_hi[d]);
+    collider_phi(c, t, x, n);
+    return fabs(n[1]) < 0.9;
+}
+
 typedef struct {
     const Scene *sc;
     double t;
@@ -346,7 +357,9 @@ static int render_state(const RenderArgs *a, const Scene *sc, const Particles *p
     if (!idx) return mpm_error(MPM_EINTERNAL, "render: out of memory");
     int n_draw = 0;
     for (int c = 0; c < sc->n_colliders; ++c)
-        if (!is_domain_wall(&sc->colliders[c]) && collider_active(&sc->colliders[c], t)) idx[n_draw++] = c;
+        if (!is_domain_wall(&sc->colliders[c]) && !is_side_wall(sc, &sc->colliders[c], t) &&
+            collider_active(&sc->colliders[c], t))
+            idx[n_draw++] = c;
 
     /* framed box: finite particles, then the colliders near them */
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
