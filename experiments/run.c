@@ -1,6 +1,7 @@
 #include "experiments/run.h"
 
 #include <errno.h>
+#include <jansson.h>
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -62,24 +63,24 @@ static void iter_hook(void *ctx, int iter, double elapsed, double residual, doub
 }
 
 /* Records the exact configuration beside the tables, so every number says
- * how it was made. */
+ * how it was made (jansson escapes every string). */
 static void write_run_json(const char *dir, const RunConfig *cfg, const Scene *sc, const SolverOptions *so,
                            int frames, int threads, int *status)
 {
-    FILE *f = open_in(dir, "run.json", status);
-    if (!f) return;
-    fprintf(f, "{\n  \"scene\": \"%s\",\n  \"scene_path\": \"%s\",\n  \"solver\": \"%s\",\n", sc->name, sc->path,
-            cfg->solver);
-    fprintf(f, "  \"solver_options\": {");
-    for (int i = 0; i < so->n; ++i) fprintf(f, "%s\"%s\": \"%s\"", i ? ", " : "", so->key[i], so->value[i]);
-    fprintf(f, "},\n  \"overrides\": {");
+    json_t *opts = json_object(), *ovr = json_object();
+    for (int i = 0; i < so->n; ++i) json_object_set_new(opts, so->key[i], json_string(so->value[i]));
     for (int i = 0; i < cfg->n_overrides; ++i)
-        fprintf(f, "%s\"%s\": \"%s\"", i ? ", " : "", cfg->overrides[i].key, cfg->overrides[i].value);
-    fprintf(f, "},\n  \"eps\": %.3e,\n  \"scale\": %g,\n  \"dx\": %.9g,\n  \"frames\": %d,\n  \"threads\": %d,\n",
-            cfg->eps, cfg->scale, sc->dx, frames, threads);
-    fprintf(f, "  \"line_search\": \"%s\",\n  \"particles\": %zu\n}\n", cfg->armijo ? "armijo" : "decrease",
-            sc->particles.n);
-    fclose(f);
+        json_object_set_new(ovr, cfg->overrides[i].key, json_string(cfg->overrides[i].value));
+    json_t *root = json_pack("{s:s, s:s, s:s, s:o, s:o, s:f, s:f, s:f, s:i, s:i, s:s, s:I}", "scene", sc->name,
+                             "scene_path", sc->path, "solver", cfg->solver, "solver_options", opts, "overrides", ovr,
+                             "eps", cfg->eps, "scale", cfg->scale, "dx", sc->dx, "frames", frames, "threads", threads,
+                             "line_search", cfg->armijo ? "armijo" : "decrease", "particles",
+                             (json_int_t)sc->particles.n);
+    char path[1200];
+    snprintf(path, sizeof path, "%s/run.json", dir);
+    if (!root || json_dump_file(root, path, JSON_INDENT(2) | JSON_PRESERVE_ORDER) != 0)
+        *status = mpm_error(MPM_EINPUT, "%s: cannot write", path);
+    json_decref(root);
 }
 
 static int worse(int a, int b) { return a > b ? a : b; } /* SolveStatus is ordered by severity */

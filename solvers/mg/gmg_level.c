@@ -73,7 +73,6 @@ void gmg_level_free(GmgLevel *L)
     grid_free(&L->grid);
     stencils_free(&L->st);
     particles_free(&L->parts);
-    free(L->order);
     memset(L, 0, sizeof *L);
 }
 

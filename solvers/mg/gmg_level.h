@@ -21,8 +21,6 @@ typedef struct {
     Grid grid;
     Stencils st;
     StepProblem pb;
-    size_t *order;
-    size_t cap_order;
 } GmgLevel;
 
 /* Builds the level at spacing h from the fine problem (whose tangent must be
