@@ -111,11 +111,11 @@ static double energy_norm_check(const char *scene, const SceneOverride *ov, int 
     unsigned long long rs = 5;
     for (size_t i = 0; i < len; ++i) v[i] = test_uniform(&rs, -1, 1);
     double lambda = 0;
-    for (int it = 0; it < 40; ++it) {
+    for (int it = 0; it < 20; ++it) {
         for (size_t i = 0; i < len; ++i) w[i] = pb->kappa[i / 3] * v[i];
         problem_project(pb, w);
         jac->ops->apply(jac, w, z);
-        PcgOptions po = {PCG_ABSOLUTE, 0, 1e-11 * sqrt(vec_dot(len, w, z)), 20000};
+        PcgOptions po = {PCG_ABSOLUTE, 0, 1e-9 * sqrt(vec_dot(len, w, z)), 20000};
         PcgResult pr;
         pcg_solve(&op, jac, &proj, w, y, &po, &work, &pr);
         for (size_t i = 0; i < len; ++i) z[i] = pb->kappa[i / 3] * y[i];
