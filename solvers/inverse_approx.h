@@ -59,6 +59,9 @@ typedef struct {
 struct InvApprox {
     const InvApproxOps *ops;
     InvStats stats;
+    /* apply is not a fixed linear map (e.g. an adaptive inner PCG): PCG then
+     * uses the flexible-CG beta (solvers/pcg.c) */
+    int variable;
 };
 
 #endif

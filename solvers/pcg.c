@@ -10,6 +10,15 @@
  *     x += alpha p;  r -= alpha q;  z = P(M^-1 r)
  *     beta = r^T z_new / r^T z_old;  p = z + beta p
  *
+ * A preconditioner that is not a fixed linear map (M->variable: a V-cycle
+ * whose coarsest PCG stops adaptively) breaks the conjugacy plain PCG relies
+ * on; with a poor coarse operator (rediscretised GMG) plain PCG then needs
+ * thousands of iterations. For those, beta takes the Polak-Ribiere form
+ * beta = z_new^T (r_new - r_old) / r_old^T z_old = -alpha z_new^T q / r_old^T z_old
+ * of flexible CG (Notay 2000, "Flexible conjugate gradients", SIAM J. Sci.
+ * Comput. 22(4)), which equals the plain beta in exact arithmetic when M is
+ * fixed and SPD.
+ *
  * Non-positive curvature: pcg.h has no flag for it, so it shows as a stop
  * with capped == 0 and rho not below the threshold. Following Gast et al.
  * 2015 §6 ("if indefiniteness is encountered during the conjugate gradient
@@ -77,6 +86,7 @@ int pcg_solve(const LinearOp *A, InvApprox *M, const Projection *proj, const dou
     int st = pcg_work_reserve(work, n);
     if (st) return st;
     double *r = work->r, *z = work->z, *p = work->p, *q = work->q;
+    const int flexible = M && M->variable;
 
     vec_zero(len, x);
     vec_copy(len, b, r);
@@ -128,6 +138,7 @@ int pcg_solve(const LinearOp *A, InvApprox *M, const Projection *proj, const dou
                              it);
         }
         double beta = rz_new / rz;
+        if (flexible) beta = -alpha * vec_dot(len, z, q) / rz;
         vec_xpby(len, z, beta, p);
         rz = rz_new;
         rho = sqrt(rz);

@@ -6,7 +6,8 @@
  *  - PCG_ABSOLUTE: stop when rho < abs_tol (coarse solves, LBFGS-H: abs_tol
  *    = 1/2 sqrt(bbar^T D^-1 bbar), reference §5.3).
  * The check is at the top of each iteration; at most max_iters iterations.
- * Vectors r, z and the search direction are kept in the projected subspace. */
+ * Vectors r, z and the search direction are kept in the projected subspace.
+ * A variable preconditioner (InvApprox.variable) gets flexible CG's beta. */
 #ifndef MPM_PCG_H
 #define MPM_PCG_H
 

@@ -32,6 +32,7 @@ static int ipcg_create(const SolverOptions *opt, InvApprox **out)
         return st;
     }
     s->base.ops = &inv_inexact_pcg_ops;
+    s->base.variable = 1; /* an adaptive inner PCG: not a fixed linear map */
     *out = &s->base;
     return MPM_OK;
 }

@@ -115,6 +115,7 @@ static int mg_create(MgEmbedding kind, int rediscretize, const SolverOptions *op
     double ctol = solver_opt_number(opt, "coarse_tol", 0.5, &st);
     double cmax = solver_opt_number(opt, "coarse_max_iters", 10000, &st);
     double exact = solver_opt_number(opt, "coarse_exact", 0, &st);
+    double flexible = solver_opt_number(opt, "flexible", 1, &st);
     if (st) return st;
     if (!(levels >= 1 && levels <= MG_MAX_LEVELS && levels == floor(levels)))
         return mpm_error(MPM_EINPUT, "--solver-opt levels=%g: expected an integer in [1, %d]", levels, MG_MAX_LEVELS);
@@ -136,6 +137,9 @@ static int mg_create(MgEmbedding kind, int rediscretize, const SolverOptions *op
     M->coarse_tol = exact != 0 ? 1e-12 : ctol;
     M->coarse_max_iters = (int)cmax;
     M->cj.base.ops = &coarse_jacobi_ops;
+    /* the adaptive coarsest PCG makes the V-cycle vary with its input: outer
+     * PCG uses flexible CG unless flexible=0 (the reference's plain PCG) */
+    M->base.variable = flexible != 0 && levels > 1;
     *out = &M->base;
     return MPM_OK;
 }
