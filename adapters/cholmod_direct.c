@@ -60,7 +60,7 @@ static const char *cholmod_status_str(int s)
     }
 }
 
-static int chol_create(const SolverOptions *opt, InvApprox **out)
+static int chol_create(SolverOptions *opt, InvApprox **out)
 {
     (void)opt; /* no options */
     CholDirect *s = calloc(1, sizeof *s);

@@ -138,7 +138,7 @@ static int hy_check(HYPRE_Int ierr, const char *what)
     return mpm_error(MPM_EINTERNAL, "boomeramg: %s failed (hypre error %d: %s)", what, (int)ierr, desc);
 }
 
-static int amg_create(const SolverOptions *opt, InvApprox **out)
+static int amg_create(SolverOptions *opt, InvApprox **out)
 {
     int st = MPM_OK;
     double strong = solver_opt_number(opt, "amg_strong_threshold", 0.5, &st);

@@ -43,25 +43,38 @@ void bsr_update_pattern_id(Bsr *A)
     A->pattern_id = h;
 }
 
+/* (A x)_i for block row i: three running sums over the row's 3x3 blocks. */
+static inline void row_product(const Bsr *A, int i, const double *restrict x, double out[3])
+{
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+    for (int64_t k = A->row_ptr[i]; k < A->row_ptr[i + 1]; ++k) {
+        const double *b = A->val + 9 * k;
+        const double *xj = x + 3 * (size_t)A->col[k];
+        double x0 = xj[0], x1 = xj[1], x2 = xj[2];
+        s0 += b[0] * x0 + b[1] * x1 + b[2] * x2;
+        s1 += b[3] * x0 + b[4] * x1 + b[5] * x2;
+        s2 += b[6] * x0 + b[7] * x1 + b[8] * x2;
+    }
+    out[0] = s0;
+    out[1] = s1;
+    out[2] = s2;
+}
+
 void bsr_spmv(const Bsr *A, const double *restrict x, double *restrict y)
 {
-    const int64_t *rp = A->row_ptr;
-    const int *col = A->col;
-    const double *val = A->val;
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < A->n; ++i) row_product(A, i, x, y + 3 * (size_t)i);
+}
+
+void bsr_spmv_sub(const Bsr *A, const double *restrict x, double *restrict r)
+{
 #pragma omp parallel for schedule(static)
     for (int i = 0; i < A->n; ++i) {
-        double s0 = 0.0, s1 = 0.0, s2 = 0.0;
-        for (int64_t k = rp[i]; k < rp[i + 1]; ++k) {
-            const double *b = val + 9 * k;
-            const double *xj = x + 3 * (size_t)col[k];
-            double x0 = xj[0], x1 = xj[1], x2 = xj[2];
-            s0 += b[0] * x0 + b[1] * x1 + b[2] * x2;
-            s1 += b[3] * x0 + b[4] * x1 + b[5] * x2;
-            s2 += b[6] * x0 + b[7] * x1 + b[8] * x2;
-        }
-        y[3 * (size_t)i] = s0;
-        y[3 * (size_t)i + 1] = s1;
-        y[3 * (size_t)i + 2] = s2;
+        double s[3];
+        row_product(A, i, x, s);
+        r[3 * (size_t)i] -= s[0];
+        r[3 * (size_t)i + 1] -= s[1];
+        r[3 * (size_t)i + 2] -= s[2];
     }
 }
 

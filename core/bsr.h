@@ -28,6 +28,8 @@ int bsr_reserve(Bsr *A, int n, int64_t nnzb);
 void bsr_update_pattern_id(Bsr *A);
 /* y = A x (row-parallel, OpenMP). */
 void bsr_spmv(const Bsr *A, const double *x, double *y);
+/* r -= A x (row-parallel). */
+void bsr_spmv_sub(const Bsr *A, const double *x, double *r);
 /* Index of block (row, col) or -1 (binary search in the sorted row). */
 int64_t bsr_find(const Bsr *A, int row, int col);
 /* Copies the diagonal blocks into diag (9n). Missing diagonal -> zero block. */

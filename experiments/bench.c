@@ -56,6 +56,32 @@ static void run_triad(void *ctx)
     for (size_t i = 0; i < b->len; ++i) a[i] = bb[i] + s * cc[i];
 }
 
+/* Best time and bandwidth (24 bytes per entry) of the triad over len doubles
+ * per array; the arrays live only for the measurement. */
+static int triad(BenchCtx *bc, size_t len, double min_s, double *t, double *gbs)
+{
+    bc->len = len;
+    bc->a = malloc(sizeof(double) * len);
+    bc->b = malloc(sizeof(double) * len);
+    bc->c = malloc(sizeof(double) * len);
+    int status = MPM_OK;
+    if (!bc->a || !bc->b || !bc->c) {
+        status = mpm_error(MPM_EINTERNAL, "out of memory in bench (triad of %zu doubles)", len);
+    } else {
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < len; ++i) {
+            bc->a[i] = 0.0;
+            bc->b[i] = 1.0;
+            bc->c[i] = 2.0;
+        }
+        *t = best_time(run_triad, bc, min_s);
+        *gbs = 24.0 * len / *t / 1e9;
+    }
+    free(bc->a), free(bc->b), free(bc->c);
+    bc->a = bc->b = bc->c = NULL;
+    return status;
+}
+
 static void run_assemble(void *ctx)
 {
     BenchCtx *b = ctx;
@@ -122,44 +148,12 @@ int bench_run(const char *what, const RunConfig *cfg)
         double t = best_time(run_spmv, &bc, min_s);
         spmv_gbs = bytes / t / 1e9;
         printf("%-28s %14.3f %11.2f GB/s\n", "block-CSR SpMV", 1e3 * t, spmv_gbs);
-        /* STREAM triad over a working set of the same size */
-        bc.len = (size_t)(bytes / 24.0);
-        bc.a = malloc(sizeof(double) * bc.len);
-        bc.b = malloc(sizeof(double) * bc.len);
-        bc.c = malloc(sizeof(double) * bc.len);
-        if (!bc.a || !bc.b || !bc.c) {
-            status = mpm_error(MPM_EINTERNAL, "out of memory in bench");
-            goto done;
-        }
-#pragma omp parallel for schedule(static)
-        for (size_t i = 0; i < bc.len; ++i) {
-            bc.a[i] = 0.0;
-            bc.b[i] = 1.0;
-            bc.c[i] = 2.0;
-        }
-        double ts = best_time(run_triad, &bc, min_s);
-        stream_gbs = 24.0 * bc.len / ts / 1e9;
+        /* STREAM triad over a working set of the same size, then one far
+         * beyond any cache (3 x 128 MB): the DRAM bandwidth */
+        double ts;
+        if ((status = triad(&bc, (size_t)(bytes / 24.0), min_s, &ts, &stream_gbs))) goto done;
         printf("%-28s %14.3f %11.2f GB/s\n", "STREAM triad (same size)", 1e3 * ts, stream_gbs);
-        /* and a triad far beyond any cache (3 x 128 MB): the DRAM bandwidth */
-        double stream_same = stream_gbs;
-        free(bc.a), free(bc.b), free(bc.c);
-        bc.len = (size_t)16 << 20;
-        bc.a = malloc(sizeof(double) * bc.len);
-        bc.b = malloc(sizeof(double) * bc.len);
-        bc.c = malloc(sizeof(double) * bc.len);
-        if (!bc.a || !bc.b || !bc.c) {
-            status = mpm_error(MPM_EINTERNAL, "out of memory in bench");
-            goto done;
-        }
-#pragma omp parallel for schedule(static)
-        for (size_t i = 0; i < bc.len; ++i) {
-            bc.a[i] = 0.0;
-            bc.b[i] = 1.0;
-            bc.c[i] = 2.0;
-        }
-        ts = best_time(run_triad, &bc, min_s);
-        stream_dram_gbs = 24.0 * bc.len / ts / 1e9;
-        stream_gbs = stream_same;
+        if ((status = triad(&bc, (size_t)16 << 20, min_s, &ts, &stream_dram_gbs))) goto done;
         printf("%-28s %14.3f %11.2f GB/s\n", "STREAM triad (384 MB)", 1e3 * ts, stream_dram_gbs);
         double tm = best_time(run_hessvec, &bc, min_s);
         mf_gbs_equiv = bytes / tm / 1e9;
@@ -192,9 +186,6 @@ int bench_run(const char *what, const RunConfig *cfg)
 done:
     free(bc.x);
     free(bc.y);
-    free(bc.a);
-    free(bc.b);
-    free(bc.c);
     bsr_free(&H);
     sim_free(&sim);
     scene_free(&scene);

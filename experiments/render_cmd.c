@@ -13,6 +13,7 @@
 #include "experiments/progress.h"
 #include "experiments/registry.h"
 #include "experiments/render.h"
+#include "experiments/run.h"
 #include "solvers/solver.h"
 
 #define RC_MAX_SET 64
@@ -305,8 +306,8 @@ static void rc_hook(void *ctx, int iter, double elapsed, double residual, double
  * SolveStatus seen. */
 static int simulate(Simulation *sim, Solver *solver, int frames, int *worst)
 {
-    int status = MPM_OK, cap = 0;
-    double *dv = NULL;
+    int status = MPM_OK;
+    StepWork work = {NULL, 0};
     Progress prog;
     progress_init(&prog, frames);
     SolveSettings set;
@@ -316,32 +317,20 @@ static int simulate(Simulation *sim, Solver *solver, int frames, int *worst)
     while (sim->frame < frames) {
         int frame = sim->frame, step = 0;
         while (sim->frame == frame) {
-            if ((status = step_begin(sim))) goto done;
-            int n = sim->pb.n_nodes;
-            if (n > cap) {
-                cap = n + n / 4 + 256;
-                double *q = realloc(dv, sizeof(double) * 3 * (size_t)cap);
-                if (!q) {
-                    status = mpm_error(MPM_EINTERNAL, "out of memory: dv");
-                    goto done;
-                }
-                dv = q;
-            }
-            problem_initial_guess(&sim->pb, dv);
             hook.frame = frame;
             hook.step = step;
             hook.fraction = (frame + sim->t_in_frame / sim->frame_dt) / frames;
             SolveStats ss;
-            if ((status = solver_solve(solver, &sim->pb, &set, dv, &ss, rc_hook, &hook))) goto done;
+            StepInfo si;
+            if ((status = run_step(sim, solver, &set, &work, rc_hook, &hook, &ss, &si))) goto done;
             if ((int)ss.status > *worst) *worst = ss.status;
-            if ((status = step_end(sim, dv))) goto done;
             ++step;
         }
         progress_clear(&prog);
     }
 done:
     progress_clear(&prog);
-    free(dv);
+    free(work.dv);
     return status;
 }
 

@@ -68,7 +68,8 @@ static void write_run_json(const char *dir, const RunConfig *cfg, const Scene *s
                            int frames, int threads, int *status)
 {
     json_t *opts = json_object(), *ovr = json_object();
-    for (int i = 0; i < so->n; ++i) json_object_set_new(opts, so->key[i], json_string(so->value[i]));
+    /* every option the solver consulted, with the value in effect (given or default) */
+    for (int i = 0; i < so->n_asked; ++i) json_object_set_new(opts, so->asked[i], json_string(so->asked_value[i]));
     for (int i = 0; i < cfg->n_overrides; ++i)
         json_object_set_new(ovr, cfg->overrides[i].key, json_string(cfg->overrides[i].value));
     json_t *root = json_pack("{s:s, s:s, s:s, s:o, s:o, s:f, s:f, s:f, s:i, s:i, s:s, s:I}", "scene", sc->name,
@@ -81,6 +82,35 @@ static void write_run_json(const char *dir, const RunConfig *cfg, const Scene *s
     if (!root || json_dump_file(root, path, JSON_INDENT(2) | JSON_PRESERVE_ORDER) != 0)
         *status = mpm_error(MPM_EINPUT, "%s: cannot write", path);
     json_decref(root);
+}
+
+int run_step(Simulation *sim, Solver *solver, const SolveSettings *set, StepWork *w, IterHook hook, void *hook_ctx,
+             SolveStats *ss, StepInfo *info)
+{
+    int status;
+    double t0 = omp_get_wtime();
+    if ((status = step_begin(sim))) return status;
+    double t1 = omp_get_wtime();
+    int n = sim->pb.n_nodes;
+    if (n > w->cap) {
+        int cap = n + n / 4 + 256;
+        double *q = realloc(w->dv, sizeof(double) * 3 * (size_t)cap);
+        if (!q) return mpm_error(MPM_EINTERNAL, "out of memory: dv (%d nodes)", n);
+        w->dv = q;
+        w->cap = cap;
+    }
+    problem_initial_guess(&sim->pb, w->dv);
+    if ((status = solver_solve(solver, &sim->pb, set, w->dv, ss, hook, hook_ctx))) return status;
+    info->t = sim->t;
+    info->dt = sim->dt;
+    info->active_nodes = n;
+    double t2 = omp_get_wtime();
+    if ((status = step_end(sim, w->dv))) return status;
+    double t3 = omp_get_wtime();
+    info->wall_s = t3 - t0;
+    info->begin_s = t1 - t0;
+    info->end_s = t3 - t2;
+    return MPM_OK;
 }
 
 static int worse(int a, int b) { return a > b ? a : b; } /* SolveStatus is ordered by severity */
@@ -110,15 +140,14 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     Simulation sim;
     memset(&sim, 0, sizeof sim);
     FILE *steps_csv = NULL, *frames_csv = NULL, *iters_csv = NULL;
-    double *dv = NULL;
-    int cap = 0;
+    StepWork work = {NULL, 0};
     if ((status = mkdir_p(out_dir))) goto done;
     if (cfg->particles_dir && (status = mkdir_p(cfg->particles_dir))) goto done;
     if ((status = solver_create(preset, &so, &solver))) goto done;
     if (!(steps_csv = open_in(out_dir, "steps.csv", &status))) goto done;
     if (!(frames_csv = open_in(out_dir, "frames.csv", &status))) goto done;
     if (cfg->history && !(iters_csv = open_in(out_dir, "iters.csv", &status))) goto done;
-    write_run_json(out_dir, cfg, &scene, &so, frames, threads, &status);
+    write_run_json(out_dir, cfg, &scene, &solver->opts, frames, threads, &status);
     if (status) goto done;
     fprintf(steps_csv, "scene,solver,frame,step,t,dt,particles,active_nodes,hessian_blocks,outer_iters,linear_iters,"
                        "ls_evals,residual,status,wall_s,p2g_s,assemble_s,setup_s,solve_s,linesearch_s,g2p_s,threads\n");
@@ -146,35 +175,18 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
         long fouter = 0, flinear = 0;
         double fwall = 0.0, fmaxres = 0.0;
         while (sim.frame == frame) {
-            double t0 = omp_get_wtime();
-            if ((status = step_begin(&sim))) goto done;
-            double t1 = omp_get_wtime();
-            int n = sim.pb.n_nodes;
-            if (n > cap) {
-                cap = n + n / 4 + 256;
-                double *q = realloc(dv, sizeof(double) * 3 * (size_t)cap);
-                if (!q) {
-                    status = mpm_error(MPM_EINTERNAL, "out of memory: dv");
-                    goto done;
-                }
-                dv = q;
-            }
-            problem_initial_guess(&sim.pb, dv);
             hook.frame = frame;
             hook.step = fsteps;
             hook.fraction = (frame + sim.t_in_frame / sim.frame_dt) / frames;
             SolveStats ss;
-            if ((status = solver_solve(solver, &sim.pb, &set, dv, &ss, iter_hook, &hook))) goto done;
-            double t2 = omp_get_wtime();
-            double t_step = sim.t, dt = sim.dt;
-            int active = n;
-            if ((status = step_end(&sim, dv))) goto done;
-            double t3 = omp_get_wtime();
-            double wall = t3 - t0;
+            StepInfo si;
+            if ((status = run_step(&sim, solver, &set, &work, iter_hook, &hook, &ss, &si))) goto done;
+            double wall = si.wall_s;
             fprintf(steps_csv, "%s,%s,%d,%d,%.9g,%.9g,%zu,%d,%lld,%d,%ld,%d,%.6e,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d\n",
-                    scene.name, preset->name, frame, fsteps, t_step, dt, sim.p.n, active, (long long)ss.hessian_blocks,
-                    ss.outer_iters, ss.linear_iters, ss.ls_evals, ss.residual, solve_status_name(ss.status), wall,
-                    t1 - t0, ss.assemble_s, ss.setup_s, ss.solve_s, ss.linesearch_s, t3 - t2, threads);
+                    scene.name, preset->name, frame, fsteps, si.t, si.dt, sim.p.n, si.active_nodes,
+                    (long long)ss.hessian_blocks, ss.outer_iters, ss.linear_iters, ss.ls_evals, ss.residual,
+                    solve_status_name(ss.status), wall, si.begin_s, ss.assemble_s, ss.setup_s, ss.solve_s,
+                    ss.linesearch_s, si.end_s, threads);
             fsteps++;
             fouter += ss.outer_iters;
             flinear += ss.linear_iters;
@@ -210,9 +222,10 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
                sum->frames ? sum->wall_s / sum->frames : 0.0, solve_status_name((SolveStatus)sum->worst_status));
         printf("wrote %s/steps.csv and %s/frames.csv%s\n", out_dir, out_dir, iters_csv ? " and iters.csv" : "");
     }
-    /* multigrid solvers: the hierarchy of the last setup (HOT Fig. 8: blocks per row per level) */
+    /* multigrid solvers: the hierarchy of the last setup (HOT Fig. 8: blocks per row per level);
+     * none when every step converged at its initial guess */
     MgInfo mgi;
-    if (!status && mg_is_multigrid(solver->inv) && mg_get_info(solver->inv, &mgi) == MPM_OK) {
+    if (!status && mg_is_multigrid(solver->inv) && mg_get_info(solver->inv, &mgi) == MPM_OK && mgi.n_levels > 0) {
         if (!cfg->quiet) mg_print_info(&mgi, stdout);
         FILE *lv = open_in(out_dir, "mg_levels.csv", &status);
         if (!lv) goto done;
@@ -225,7 +238,7 @@ done:
     if (steps_csv) fclose(steps_csv);
     if (frames_csv) fclose(frames_csv);
     if (iters_csv) fclose(iters_csv);
-    free(dv);
+    free(work.dv);
     sim_free(&sim);
     solver_destroy(solver);
     scene_free(&scene);

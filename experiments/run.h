@@ -4,6 +4,8 @@
 #define MPM_RUN_H
 
 #include "core/scene.h"
+#include "core/step.h"
+#include "solvers/solver.h"
 
 typedef struct {
     const char *scene;          /* built-in name or JSON path */
@@ -32,6 +34,23 @@ typedef struct {
     size_t particles;
     int threads;
 } RunSummary;
+
+/* One timestep: step_begin, the initial guess, the solve, step_end. dv grows
+ * with the grid; its storage persists across calls (free *dv at the end). */
+typedef struct {
+    double *dv;
+    int cap;
+} StepWork;
+
+typedef struct {
+    double t, dt;               /* the step's start time and length */
+    int active_nodes;
+    double wall_s;              /* the whole step */
+    double begin_s, end_s;      /* step_begin (P2G, BCs) and step_end (G2P, ...) */
+} StepInfo;
+
+int run_step(Simulation *sim, Solver *solver, const SolveSettings *set, StepWork *w, IterHook hook, void *hook_ctx,
+             SolveStats *ss, StepInfo *info);
 
 void run_config_default(RunConfig *c);
 int run_simulation(const RunConfig *cfg, RunSummary *sum);

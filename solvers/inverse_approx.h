@@ -18,17 +18,30 @@
 
 struct StepProblem;
 
-/* Free-form options (`--solver-opt key=value`), shared by all parts. */
+/* Free-form options (`--solver-opt key=value`), shared by all parts. Every
+ * lookup records the key it asked for with the value in effect (given or
+ * default) and marks a given key used, so that after a solver is created
+ *  - a key nobody asked for is reported as unknown (a typo must not run
+ *    silently with the default; cf. PETSc's -options_left), and
+ *  - the effective options can be written beside the results (run.json). */
+#define SOLVER_MAX_OPTS 32
 typedef struct {
     int n;
-    char key[32][32];
-    char value[32][64];
+    char key[SOLVER_MAX_OPTS][32];
+    char value[SOLVER_MAX_OPTS][64];
+    unsigned char used[SOLVER_MAX_OPTS];
+    int n_asked;                         /* distinct keys looked up */
+    char asked[SOLVER_MAX_OPTS][32];
+    char asked_value[SOLVER_MAX_OPTS][64]; /* value in effect */
 } SolverOptions;
 
 /* Looks up an option; returns the default when absent, and MPM_EINPUT through
  * *status (left untouched on success) when present but not a number. */
-double solver_opt_number(const SolverOptions *o, const char *key, double def, int *status);
-const char *solver_opt_string(const SolverOptions *o, const char *key, const char *def);
+double solver_opt_number(SolverOptions *o, const char *key, double def, int *status);
+const char *solver_opt_string(SolverOptions *o, const char *key, const char *def);
+/* MPM_EINPUT naming the first option no lookup asked for, and the options
+ * `who` does take. */
+int solver_opts_check_used(const SolverOptions *o, const char *who);
 
 typedef struct {
     int n_nodes;
@@ -50,7 +63,7 @@ typedef struct {
 typedef struct InvApprox InvApprox;
 typedef struct {
     const char *name;
-    int (*create)(const SolverOptions *opt, InvApprox **out);
+    int (*create)(SolverOptions *opt, InvApprox **out);
     int (*setup)(InvApprox *self, const InvSetupInput *in);
     int (*apply)(InvApprox *self, const double *r, double *z);
     void (*destroy)(InvApprox *self);

@@ -44,12 +44,12 @@ static int jacobi_create(int scalar, InvApprox **out)
     return MPM_OK;
 }
 
-static int block_create(const SolverOptions *opt, InvApprox **out)
+static int block_create(SolverOptions *opt, InvApprox **out)
 {
     (void)opt;
     return jacobi_create(0, out);
 }
-static int scalar_create(const SolverOptions *opt, InvApprox **out)
+static int scalar_create(SolverOptions *opt, InvApprox **out)
 {
     (void)opt;
     return jacobi_create(1, out);

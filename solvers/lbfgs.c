@@ -30,20 +30,8 @@ int lbfgs_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv
     LineSearchOptions lso = {set->armijo, set->max_halvings};
     int m = s->window, count = 0, head = 0; /* ring buffer of the newest `count` pairs; head = next slot */
     long inner_before = 0;
-    st->status = SOLVE_CAPPED;
     for (int it = 0;; ++it) {
-        double res = problem_cn_residual(pb, s->g);
-        st->residual = res;
-        if (hook) hook(hook_ctx, it, omp_get_wtime() - t_start, res, E);
-        if (!isfinite(res) || !isfinite(E)) {
-            st->status = SOLVE_FAILED;
-            break;
-        }
-        if (res < set->eps) {
-            st->status = SOLVE_CONVERGED;
-            break;
-        }
-        if (it >= set->max_outer) break;
+        if (solver_should_stop(pb, set, s->g, E, it, t_start, hook, hook_ctx, st)) break;
         st->outer_iters++;
         if (it == 0) {
             /* the Hessian and its inverse approximation, once per step, lagged at dv^0 */

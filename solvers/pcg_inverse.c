@@ -19,7 +19,7 @@ typedef struct {
     int cap, n, max_iters;
 } InexactPcg;
 
-static int ipcg_create(const SolverOptions *opt, InvApprox **out)
+static int ipcg_create(SolverOptions *opt, InvApprox **out)
 {
     InexactPcg *s = calloc(1, sizeof *s);
     if (!s) return mpm_error(MPM_EINTERNAL, "out of memory: inexact PCG");

@@ -2,7 +2,6 @@
  * projected (SPD) Hessian is rebuilt, H p = -g is solved inexactly by PCG
  * with the forcing term eta = min(0.5, sqrt(max(rho0, tau))), and a
  * backtracking line search takes the step. Stops by the CN rule. */
-#include <math.h>
 #include <omp.h>
 #include <string.h>
 
@@ -28,20 +27,8 @@ int pn_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv, S
     solver_hessian_op(s, pb, assembled, &op);
     solver_projection(pb, &proj);
     LineSearchOptions lso = {set->armijo, set->max_halvings};
-    st->status = SOLVE_CAPPED;
     for (int it = 0;; ++it) {
-        double res = problem_cn_residual(pb, s->g);
-        st->residual = res;
-        if (hook) hook(hook_ctx, it, omp_get_wtime() - t_start, res, E);
-        if (!isfinite(res) || !isfinite(E)) {
-            st->status = SOLVE_FAILED;
-            break;
-        }
-        if (res < set->eps) {
-            st->status = SOLVE_CONVERGED;
-            break;
-        }
-        if (it >= set->max_outer) break;
+        if (solver_should_stop(pb, set, s->g, E, it, t_start, hook, hook_ctx, st)) break;
         st->outer_iters++;
 
         double t0 = omp_get_wtime();

@@ -141,7 +141,7 @@ typedef struct {
     double *work; /* 6 cap */
 } Sgs;
 
-static int sgs_create(const SolverOptions *opt, InvApprox **out)
+static int sgs_create(SolverOptions *opt, InvApprox **out)
 {
     (void)opt;
     Sgs *S = calloc(1, sizeof *S);

@@ -1,5 +1,6 @@
 #include "solvers/solver.h"
 
+#include <math.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -32,22 +33,50 @@ int solver_create(const SolverPreset *preset, const SolverOptions *opts, Solver 
     s->preset = preset;
     if (opts) s->opts = *opts;
     int status = MPM_OK;
-    s->window = (int)solver_opt_number(&s->opts, "window", 8, &status);
-    if (status) {
-        free(s);
-        return status;
-    }
-    if (s->window < 1 || s->window > 64) {
-        int w = s->window;
-        free(s);
-        return mpm_error(MPM_EINPUT, "--solver-opt window=%d: expected 1..64", w);
+    s->window = 8;
+    if (preset->method == METHOD_LBFGS) {
+        s->window = (int)solver_opt_number(&s->opts, "window", 8, &status);
+        if (status) {
+            free(s);
+            return status;
+        }
+        if (s->window < 1 || s->window > 64) {
+            int w = s->window;
+            free(s);
+            return mpm_error(MPM_EINPUT, "--solver-opt window=%d: expected 1..64", w);
+        }
     }
     if (preset->inv && (status = preset->inv->create(&s->opts, &s->inv))) {
         free(s);
         return status;
     }
+    if ((status = solver_opts_check_used(&s->opts, preset->name))) {
+        solver_destroy(s);
+        return status;
+    }
     *out = s;
     return MPM_OK;
+}
+
+int solver_should_stop(StepProblem *pb, const SolveSettings *set, const double *g, double E, int it, double t_start,
+                       IterHook hook, void *hook_ctx, SolveStats *st)
+{
+    double res = problem_cn_residual(pb, g);
+    st->residual = res;
+    if (hook) hook(hook_ctx, it, omp_get_wtime() - t_start, res, E);
+    if (!isfinite(res) || !isfinite(E)) {
+        st->status = SOLVE_FAILED;
+        return 1;
+    }
+    if (res < set->eps) {
+        st->status = SOLVE_CONVERGED;
+        return 1;
+    }
+    if (it >= set->max_outer) {
+        st->status = SOLVE_CAPPED;
+        return 1;
+    }
+    return 0;
 }
 
 int solver_reserve(Solver *s, int n)

@@ -74,6 +74,12 @@ int pn_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv, S
 int lbfgs_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv, SolveStats *st, IterHook hook,
                 void *hook_ctx);
 
+/* The stopping test every outer method runs at the top of iteration `it`
+ * (SPEC 4, 5): records the CN residual of g in st and calls the hook; returns
+ * 1 with st->status set when the solve ends here (converged, failed on a
+ * non-finite residual or energy, or capped at max_outer), 0 to iterate. */
+int solver_should_stop(StepProblem *pb, const SolveSettings *set, const double *g, double E, int it, double t_start,
+                       IterHook hook, void *hook_ctx, SolveStats *st);
 /* Shared by the outer methods: grows work vectors to n nodes. */
 int solver_reserve(Solver *s, int n_nodes);
 /* The BC-projected Hessian as a LinearOp (assembled or matrix-free). */

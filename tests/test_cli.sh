@@ -47,6 +47,16 @@ check "every step converged" awk -F, 'NR>1 && $14!="converged"{bad=1} END{exit b
 check "frames.csv has one row" test "$(wc -l <"$tmp/run/frames.csv")" -eq 2
 check "run.json written" grep -q '"solver": "pn-pcg"' "$tmp/run/run.json"
 
+# run.json records every option the solver consulted with the value in effect
+"$bin" run --scene stretched-box --scale 3.6 --solver hot --solver-opt embedding=quadratic --frames 1 --quiet \
+  --out "$tmp/hotq-opt"
+check "run.json: given option" grep -q '"embedding": "quadratic"' "$tmp/hotq-opt/run.json"
+check "run.json: default option" grep -q '"window": "8"' "$tmp/hotq-opt/run.json"
+# ... and hot with the quadratic embedding is the hot-quadratic preset, step for step
+"$bin" run --scene stretched-box --scale 3.6 --solver hot-quadratic --frames 1 --quiet --out "$tmp/hotq"
+check "embedding=quadratic reproduces hot-quadratic" \
+  test "$(cut -d, -f10-13 "$tmp/hotq-opt/steps.csv")" = "$(cut -d, -f10-13 "$tmp/hotq/steps.csv")"
+
 # bad usage and bad input
 expect_input_error "unknown solver 'nosuch'" run --scene drop --solver nosuch
 expect_input_error "nosuchscene" run --scene nosuchscene --solver pn-pcg
@@ -56,6 +66,10 @@ expect_input_error "--eps" run --scene drop --solver pn-pcg --eps abc
 expect_input_error "unknown option" run --scene drop --solver pn-pcg --bogus
 expect_input_error "materials.ends.E|E.*-5" run --scene bar3 --solver pn-pcg --set materials.ends.E=-5
 expect_input_error "nu" run --scene bar3 --solver pn-pcg --set materials.middle.nu=0.5
+# a solver option nobody reads is a typo, not a silent default
+expect_input_error "hot has no option 'level'.*levels" run --scene drop --solver hot --solver-opt level=2
+expect_input_error "pn-pcg has no option 'window'" run --scene drop --solver pn-pcg --solver-opt window=4
+expect_input_error "levels=x: expected a number" run --scene drop --solver hot --solver-opt levels=x
 
 printf '{ "name": "broken", \n "dx": 0.1,, }\n' >"$tmp/malformed.json"
 expect_input_error "malformed.json" run --scene "$tmp/malformed.json" --solver pn-pcg

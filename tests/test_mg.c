@@ -233,7 +233,7 @@ typedef struct {
     double relres;
 } SolveStat;
 
-static SolveStat pcg_with(const SynthProblem *p, const InvApproxOps *ops, const SolverOptions *o, const double *b,
+static SolveStat pcg_with(const SynthProblem *p, const InvApproxOps *ops, SolverOptions *o, const double *b,
                           double *x, double rel_tol, int print_info)
 {
     SolveStat s = {0};

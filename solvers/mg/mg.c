@@ -63,28 +63,6 @@ static const InvApproxOps coarse_jacobi_ops = {"mg-coarse-jacobi", NULL, NULL, c
 
 static void level_spmv(const void *ctx, const double *x, double *y) { bsr_spmv((const Bsr *)ctx, x, y); }
 
-/* r -= A x (row-parallel) */
-static void spmv_sub(const Bsr *A, const double *restrict x, double *restrict r)
-{
-    const int64_t *rp = A->row_ptr;
-    const int *col = A->col;
-    const double *val = A->val;
-#pragma omp parallel for schedule(static)
-    for (int i = 0; i < A->n; ++i) {
-        double s0 = 0.0, s1 = 0.0, s2 = 0.0;
-        for (int64_t k = rp[i]; k < rp[i + 1]; ++k) {
-            const double *b = val + 9 * k;
-            const double *xj = x + 3 * (size_t)col[k];
-            double x0 = xj[0], x1 = xj[1], x2 = xj[2];
-            s0 += b[0] * x0 + b[1] * x1 + b[2] * x2;
-            s1 += b[3] * x0 + b[4] * x1 + b[5] * x2;
-            s2 += b[6] * x0 + b[7] * x1 + b[8] * x2;
-        }
-        r[3 * (size_t)i] -= s0;
-        r[3 * (size_t)i + 1] -= s1;
-        r[3 * (size_t)i + 2] -= s2;
-    }
-}
 
 static int level_reserve(MgLevel *L, int n, int own_diag)
 {
@@ -106,7 +84,7 @@ static int level_reserve(MgLevel *L, int n, int own_diag)
     return MPM_OK;
 }
 
-static int mg_create(MgEmbedding kind, int rediscretize, const SolverOptions *opt, InvApprox **out)
+static int mg_create(MgEmbedding kind, int rediscretize, SolverOptions *opt, InvApprox **out)
 {
     int st = MPM_OK;
     double levels = solver_opt_number(opt, "levels", 3, &st);
@@ -117,6 +95,12 @@ static int mg_create(MgEmbedding kind, int rediscretize, const SolverOptions *op
     double exact = solver_opt_number(opt, "coarse_exact", 0, &st);
     double flexible = solver_opt_number(opt, "flexible", 1, &st);
     if (st) return st;
+    if (!rediscretize) { /* the Galerkin hierarchy's embedding kernel (SPEC 6) */
+        const char *emb = solver_opt_string(opt, "embedding", kind == MG_EMBED_LINEAR ? "linear" : "quadratic");
+        if (!strcmp(emb, "linear")) kind = MG_EMBED_LINEAR;
+        else if (!strcmp(emb, "quadratic")) kind = MG_EMBED_QUADRATIC;
+        else return mpm_error(MPM_EINPUT, "--solver-opt embedding=%s: expected linear or quadratic", emb);
+    }
     if (!(levels >= 1 && levels <= MG_MAX_LEVELS && levels == floor(levels)))
         return mpm_error(MPM_EINPUT, "--solver-opt levels=%g: expected an integer in [1, %d]", levels, MG_MAX_LEVELS);
     if (!(sweeps >= 1 && sweeps <= 100 && sweeps == floor(sweeps)))
@@ -144,15 +128,15 @@ static int mg_create(MgEmbedding kind, int rediscretize, const SolverOptions *op
     return MPM_OK;
 }
 
-static int mg_linear_create(const SolverOptions *opt, InvApprox **out)
+static int mg_linear_create(SolverOptions *opt, InvApprox **out)
 {
     return mg_create(MG_EMBED_LINEAR, 0, opt, out);
 }
-static int mg_quadratic_create(const SolverOptions *opt, InvApprox **out)
+static int mg_quadratic_create(SolverOptions *opt, InvApprox **out)
 {
     return mg_create(MG_EMBED_QUADRATIC, 0, opt, out);
 }
-static int gmg_create(const SolverOptions *opt, InvApprox **out) { return mg_create(MG_EMBED_LINEAR, 1, opt, out); }
+static int gmg_create(SolverOptions *opt, InvApprox **out) { return mg_create(MG_EMBED_LINEAR, 1, opt, out); }
 
 static void fill_level_info(Mg *M, int l)
 {
@@ -251,7 +235,7 @@ static void smooth(Mg *M, int l, int from_zero, int last_residual)
         double *target = (from_zero && s == 0) ? L->u : L->d;
         sgs_sweep(L->A, L->dinv, L->col, L->r, target, L->work);
         if (target == L->d) vec_axpy(len, 1.0, L->d, L->u);
-        if (s + 1 < M->sweeps || last_residual) spmv_sub(L->A, target, L->r);
+        if (s + 1 < M->sweeps || last_residual) bsr_spmv_sub(L->A, target, L->r);
     }
 }
 
@@ -307,7 +291,7 @@ static int mg_apply(InvApprox *self, const double *in, double *out)
             t0 = omp_get_wtime();
             mg_prolong(&L->T, M->lev[l + 1].u, L->d);
             vec_axpy(len, 1.0, L->d, L->u);
-            spmv_sub(L->A, L->d, L->r);
+            bsr_spmv_sub(L->A, L->d, L->r);
             double t1 = omp_get_wtime();
             smooth(M, l, 0, 0);
             M->info.transfer_apply_s += t1 - t0;

@@ -19,9 +19,11 @@
  * With one level this is block-Jacobi PCG on H with the same 1/2 rule
  * (LBFGS-H), using the input projection.
  *
- * Options (solver_opt_number): levels (3), sweeps (1), min_coarse_nodes
- * (300), coarse_tol (0.5), coarse_max_iters (10000), coarse_exact (0; 1 sets
- * coarse_tol = 1e-12, used to test that the V-cycle is then symmetric).
+ * Options (--solver-opt): levels (3), sweeps (1), min_coarse_nodes (300),
+ * coarse_tol (0.5), coarse_max_iters (10000), coarse_exact (0; 1 sets
+ * coarse_tol = 1e-12, used to test that the V-cycle is then symmetric),
+ * flexible (1: outer PCG uses the flexible-CG update), and for the Galerkin
+ * hierarchies embedding (linear | quadratic; the preset's kernel by default).
  * stats.inner_iters counts coarse PCG iterations since the last setup. */
 #ifndef MPM_MG_MG_H
 #define MPM_MG_MG_H
