@@ -50,6 +50,7 @@ typedef struct {
     CoarseJacobi cj;
     MgInfo info;
     int rediscretize;            /* baseline GMG: coarse levels from particles */
+    int gmg_bc_project;          /* GMG: project coarse residuals at coarse Dirichlet nodes */
     GmgLevel gl[MG_MAX_LEVELS];  /* their particle copies and grids */
 } Mg;
 
@@ -94,6 +95,7 @@ static int mg_create(MgEmbedding kind, int rediscretize, SolverOptions *opt, Inv
     double cmax = solver_opt_number(opt, "coarse_max_iters", 10000, &st);
     double exact = solver_opt_number(opt, "coarse_exact", 0, &st);
     double flexible = solver_opt_number(opt, "flexible", 1, &st);
+    double bc_project = rediscretize ? solver_opt_number(opt, "coarse_bc_project", 1, &st) : 0;
     if (st) return st;
     if (!rediscretize) { /* the Galerkin hierarchy's embedding kernel (SPEC 6) */
         const char *emb = solver_opt_string(opt, "embedding", kind == MG_EMBED_LINEAR ? "linear" : "quadratic");
@@ -115,6 +117,7 @@ static int mg_create(MgEmbedding kind, int rediscretize, SolverOptions *opt, Inv
     M->base.ops = rediscretize ? &inv_gmg_ops : kind == MG_EMBED_LINEAR ? &inv_mg_linear_ops : &inv_mg_quadratic_ops;
     M->kind = kind;
     M->rediscretize = rediscretize;
+    M->gmg_bc_project = bc_project != 0;
     M->max_levels = (int)levels;
     M->sweeps = (int)sweeps;
     M->min_coarse = (int)minc;
@@ -239,6 +242,19 @@ static void smooth(Mg *M, int l, int from_zero, int last_residual)
     }
 }
 
+/* coarse = R_l fine. On a rediscretised (GMG) level the coarse residual is
+ * also projected at that level's own Dirichlet nodes: the coarse space is
+ * its free nodes only. Their identity rows would otherwise turn the
+ * restricted force-like residual there into a velocity correction of the
+ * wrong scale (off by m_I + dt^2 k_I, ~1e4 for aluminium), which the linear
+ * prolongation hands to the free fine nodes near every collider. The
+ * Galerkin levels need nothing: R A_bc P inherits the BCs (reference §5.1). */
+static void restrict_level(const Mg *M, int l, const double *fine, double *coarse)
+{
+    mg_restrict(&M->lev[l].T, fine, coarse);
+    if (M->rediscretize && M->gmg_bc_project) problem_project(&M->gl[l + 1].pb, coarse);
+}
+
 static int mg_apply(InvApprox *self, const double *in, double *out)
 {
     Mg *M = (Mg *)self;
@@ -256,7 +272,7 @@ static int mg_apply(InvApprox *self, const double *in, double *out)
     double t0 = omp_get_wtime();
     const double *bbar = in;
     for (int l = 0; l < c; ++l) {
-        mg_restrict(&M->lev[l].T, bbar, M->lev[l + 1].d);
+        restrict_level(M, l, bbar, M->lev[l + 1].d);
         bbar = M->lev[l + 1].d;
     }
     vec_block_apply((size_t)Lc->n, Lc->dinv, bbar, Lc->work);
@@ -277,7 +293,7 @@ static int mg_apply(InvApprox *self, const double *in, double *out)
             t0 = omp_get_wtime();
             smooth(M, l, 1, 1);
             double t1 = omp_get_wtime();
-            mg_restrict(&L->T, L->r, M->lev[l + 1].r);
+            restrict_level(M, l, L->r, M->lev[l + 1].r);
             M->info.smooth_s[l] += t1 - t0;
             M->info.transfer_apply_s += omp_get_wtime() - t1;
         }
