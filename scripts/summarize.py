@@ -2,7 +2,7 @@
 """Summary table of mpmbench runs, with times relative to a baseline solver.
 
 usage: scripts/summarize.py [--baseline NAME] [--focus NAME] [--csv FILE]
-                            [--no-markdown] RUN_DIR ...
+                            [--from-frame [SCENE=]N ...] [--no-markdown] RUN_DIR ...
 
 Each RUN_DIR is the --out directory of one `mpmbench run` (frames.csv and
 run.json); a directory without frames.csv is searched recursively for run
@@ -17,6 +17,11 @@ fewer frames than asked is marked incomplete), and the time ratio to the
 baseline solver of the same case (s/frame over the baseline's s/frame, so
 runs cut short still compare) with its inverse, the speedup over the
 baseline.
+
+--from-frame N counts only frames N, N+1, ... (0-based, as in frames.csv) of
+every run, SCENE=N only those of that scene's runs: a benchmark whose action
+starts late (a pusher reaching its target) is timed over the frames that
+have it; the frames column then shows the window.
 
 Prints a Markdown table (and, when the --focus solver is present, default
 "hot", a small table of its speedup over the baseline per case); --csv also
@@ -61,7 +66,7 @@ def number(s, default=float("nan")):
         return default
 
 
-def load_run(d):
+def load_run(d, from_frame=0):
     meta = {}
     try:
         with open(os.path.join(d, "run.json")) as f:
@@ -70,6 +75,9 @@ def load_run(d):
         print(f"summarize: warning: {d}/run.json: {e}; using frames.csv only", file=sys.stderr)
     with open(os.path.join(d, "frames.csv"), newline="") as f:
         rows = list(csv.DictReader(f))
+    frames_done = len(rows)
+    if from_frame:
+        rows = [x for x in rows if int(number(x["frame"], -1)) >= from_frame]
     r = {
         "dir": d,
         "scene": meta.get("scene") or (rows[0]["scene"] if rows else "?"),
@@ -81,6 +89,8 @@ def load_run(d):
         "threads": meta.get("threads", rows[0].get("threads") if rows else ""),
         "particles": meta.get("particles", ""),
         "frames": len(rows),
+        "from_frame": from_frame,
+        "frames_done": frames_done,
         "steps": sum(int(number(x["steps"], 0)) for x in rows),
         "outer": sum(int(number(x["outer_iters"], 0)) for x in rows),
         "linear": sum(int(number(x["linear_iters"], 0)) for x in rows),
@@ -92,7 +102,7 @@ def load_run(d):
         if STATUS_RANK.get(x["status"], 9) > STATUS_RANK.get(worst, -1):
             worst = x["status"]
     r["status"] = worst
-    r["complete"] = r["frames_asked"] is None or r["frames"] >= r["frames_asked"]
+    r["complete"] = r["frames_asked"] is None or frames_done >= r["frames_asked"]
     r["s_per_frame"] = r["wall"] / r["frames"] if r["frames"] else float("nan")
     return r
 
@@ -131,13 +141,30 @@ def main(argv):
     ap.add_argument("--focus", default="hot", help="solver whose speedup gets its own table (default hot)")
     ap.add_argument("--csv", help="also write the rows to this CSV file")
     ap.add_argument("--no-markdown", action="store_true", help="print nothing (with --csv)")
+    ap.add_argument("--from-frame", action="append", default=[], metavar="[SCENE=]N",
+                    help="count only frames >= N (of SCENE's runs); repeatable")
     a = ap.parse_args(argv)
+    windows = {}
+    for w in a.from_frame:
+        scene, _, n = w.rpartition("=")
+        try:
+            windows[scene] = int(n)
+        except ValueError:
+            print(f"summarize: --from-frame {w}: expected [SCENE=]N with N an integer", file=sys.stderr)
+            return 2
+        if windows[scene] < 0:
+            print(f"summarize: --from-frame {w}: expected N >= 0", file=sys.stderr)
+            return 2
 
     dirs = find_runs(a.runs)
     if not dirs:
         print("summarize: no run directories (with frames.csv) found", file=sys.stderr)
         return 2
-    runs = [load_run(d) for d in dirs]
+    runs = []
+    for d in dirs:
+        r = load_run(d)
+        start = windows.get(r["scene"], windows.get("", 0))
+        runs.append(load_run(d, start) if start else r)
 
     # cases and solver order (first appearance)
     keys = sorted({k for r in runs for k in r["overrides"]})
@@ -180,7 +207,9 @@ def main(argv):
             if b is not None and b["s_per_frame"] > 0 and r["s_per_frame"] > 0:
                 ratio = r["s_per_frame"] / b["s_per_frame"]
                 speedup = 1.0 / ratio
-            frames = f"{r['frames']}" if r["frames_asked"] is None else f"{r['frames']}/{r['frames_asked']}"
+            frames = f"{r['frames']}" if r["frames_asked"] is None else f"{r['frames_done']}/{r['frames_asked']}"
+            if r["from_frame"]:
+                frames = f"{r['from_frame']}-{r['frames_done'] - 1} of {frames}"
             status = r["status"] if r["complete"] else f"incomplete ({r['status']})"
             row = [case[0]] + list(case[3])
             if len(scales) > 1:
@@ -194,7 +223,8 @@ def main(argv):
                 "scene": case[0], "scale": case[1], "eps": case[2],
                 "overrides": ";".join(f"{k}={v}" for k, v in zip(keys, case[3]) if v != ""),
                 **{k: v for k, v in zip(keys, case[3])},
-                "solver": s, "frames_done": r["frames"],
+                "solver": s, "frames_done": r["frames_done"], "from_frame": r["from_frame"],
+                "frames_timed": r["frames"],
                 "frames_asked": "" if r["frames_asked"] is None else r["frames_asked"],
                 "steps": r["steps"], "outer_iters": r["outer"], "linear_iters": r["linear"],
                 "wall_s": f"{r['wall']:.6f}", "s_per_frame": f"{r['s_per_frame']:.6f}",
@@ -207,7 +237,7 @@ def main(argv):
 
     if a.csv:
         fields = (["scene", "scale", "eps", "overrides"] + keys +
-                  ["solver", "frames_done", "frames_asked", "steps", "outer_iters", "linear_iters", "wall_s",
+                  ["solver", "frames_done", "from_frame", "frames_timed", "frames_asked", "steps", "outer_iters", "linear_iters", "wall_s",
                    "s_per_frame", "max_residual", "worst_status", "complete", f"ratio_to_{base}",
                    f"speedup_vs_{base}", "threads", "particles", "run_dir"])
         try:
