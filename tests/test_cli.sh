@@ -2,33 +2,7 @@
 # Command-line contract: listings, a short run writing the CSV files with the
 # documented columns, and bad input giving exit status 2 with one line that
 # names the problem.
-set -u
-bin="$1"
-src="$2"
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fails=0
-checks=0
-
-check() { # description, condition-command...
-  local what="$1"; shift
-  checks=$((checks + 1))
-  if ! "$@"; then echo "FAIL: $what"; fails=$((fails + 1)); fi
-}
-
-# expect_input_error <pattern> <args...>: exit 2, exactly one stderr line matching pattern
-expect_input_error() {
-  local pattern="$1"; shift
-  "$bin" "$@" >"$tmp/out" 2>"$tmp/err"
-  local rc=$?
-  checks=$((checks + 1))
-  local lines
-  lines=$(wc -l <"$tmp/err")
-  if [ "$rc" -ne 2 ] || [ "$lines" -ne 1 ] || ! grep -qiE -e "$pattern" "$tmp/err"; then
-    echo "FAIL: '$*' gave exit $rc, stderr ($lines lines): $(cat "$tmp/err")  [wanted /$pattern/]"
-    fails=$((fails + 1))
-  fi
-}
+. "$(dirname "$0")/shell_harness.sh"
 
 "$bin" list solvers >"$tmp/solvers"
 check "list solvers has pn-pcg" grep -q "^pn-pcg " "$tmp/solvers"
@@ -91,5 +65,4 @@ expect_input_error "nan.json.*gravity" run --scene "$tmp/nan.json" --solver pn-p
 printf '{"name":"x","dx":0.1,"frames":1,"fps":24,"domain":{"min":[0,0,0],"max":[1,1,1]},"materials":{"m":{"E":1e5,"nu":0.3,"density":1000}},"objects":[{"material":"m","ppc":8,"shape":{"type":"sphere","center":[0.5,0.5,0.5],"radius":NaN}}]}' >"$tmp/nanlit.json"
 expect_input_error "nanlit.json" run --scene "$tmp/nanlit.json" --solver pn-pcg
 
-echo "$((checks - fails)) passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish

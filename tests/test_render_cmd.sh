@@ -2,20 +2,8 @@
 # `mpmbench render`: pictures of the initial state of drop and bar3 (coarse)
 # are PNG files of a sane size, options shape the image, and bad input gives
 # exit status 2 with one line that names the problem.
-set -u
-bin="$1"
-src="$2"
+. "$(dirname "$0")/shell_harness.sh"
 export MPM_SCENE_DIR="$src/experiments/scenes"
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fails=0
-checks=0
-
-check() { # description, condition-command...
-  local what="$1"; shift
-  checks=$((checks + 1))
-  if ! "$@"; then echo "FAIL: $what"; fails=$((fails + 1)); fi
-}
 
 # png_size FILE: prints "W H" from the IHDR chunk, nothing if not a PNG
 png_size() {
@@ -44,19 +32,6 @@ png_ok() {
 # png_is FILE W H
 png_is() { [ "$(png_size "$1")" = "$2 $3" ] || { echo "  $1: $(png_size "$1"), wanted $2 $3"; return 1; }; }
 
-# expect_input_error <pattern> <args...>: exit 2, exactly one stderr line matching pattern
-expect_input_error() {
-  local pattern="$1"; shift
-  "$bin" "$@" >"$tmp/out" 2>"$tmp/err"
-  local rc=$?
-  checks=$((checks + 1))
-  local lines
-  lines=$(wc -l <"$tmp/err")
-  if [ "$rc" -ne 2 ] || [ "$lines" -ne 1 ] || ! grep -qiE -e "$pattern" "$tmp/err"; then
-    echo "FAIL: '$*' gave exit $rc, stderr ($lines lines): $(cat "$tmp/err")  [wanted /$pattern/]"
-    fails=$((fails + 1))
-  fi
-}
 
 # frame 0 of drop, default name <scene>.png in the working directory
 (cd "$tmp" && "$bin" render --scene drop --scale 4 >"$tmp/drop.out" 2>"$tmp/drop.err")
@@ -103,5 +78,4 @@ expect_input_error "materials.soft.E|E.*-5" render --scene drop --set materials.
 expect_input_error "no_such_dir" render --scene drop --scale 4 --out "$tmp/no_such_dir/x.png"
 check "no picture from bad input" test ! -e "$tmp/x.png"
 
-echo "$((checks - fails)) passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish

@@ -2,17 +2,7 @@
 # scripts/summarize.py on hand-made runs with known numbers: totals, seconds
 # per frame, the time ratio and speedup against the baseline, a frame window
 # (--from-frame), an incomplete run, and bad arguments.
-set -u
-src="$2"
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fails=0
-checks=0
-check() { # description, condition-command...
-  local what="$1"; shift
-  checks=$((checks + 1))
-  if ! "$@"; then echo "FAIL: $what"; fails=$((fails + 1)); fi
-}
+. "$(dirname "$0")/shell_harness.sh"
 
 # run DIR SOLVER FRAMES_ASKED "wall outer linear status" per frame...
 make_run() {
@@ -61,5 +51,4 @@ check "bad --from-frame: message" grep -q "from-frame toy=x" "$tmp/err"
 py "$tmp/nothing-here" >/dev/null 2>&1
 check "no runs: exit 2" test $? -eq 2
 
-echo "$((checks - fails)) passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish

@@ -1,0 +1,37 @@
+# Shared by the tests/test_*.sh CLI tests (sourced, not a test itself):
+# `bin` and `src` from the arguments CTest passes, a scratch directory `tmp`
+# removed at exit, and the checks below counting into `checks` / `fails`;
+# a test ends with `finish`.
+set -u
+bin="$1"
+src="$2"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fails=0
+checks=0
+
+check() { # description, condition-command...
+  local what="$1"; shift
+  checks=$((checks + 1))
+  if ! "$@"; then echo "FAIL: $what"; fails=$((fails + 1)); fi
+}
+
+# expect_input_error <pattern> <mpmbench args...>: exit 2 and exactly one
+# stderr line matching pattern
+expect_input_error() {
+  local pattern="$1"; shift
+  "$bin" "$@" >"$tmp/out" 2>"$tmp/err"
+  local rc=$?
+  checks=$((checks + 1))
+  local lines
+  lines=$(wc -l <"$tmp/err")
+  if [ "$rc" -ne 2 ] || [ "$lines" -ne 1 ] || ! grep -qiE -e "$pattern" "$tmp/err"; then
+    echo "FAIL: '$*' gave exit $rc, stderr ($lines lines): $(cat "$tmp/err")  [wanted /$pattern/]"
+    fails=$((fails + 1))
+  fi
+}
+
+finish() {
+  echo "$((checks - fails)) passed, $fails failed"
+  [ "$fails" -eq 0 ]
+}
