@@ -22,5 +22,15 @@ fi
 if [ ! -f build/CMakeCache.txt ]; then
   cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 fi
-cmake --build build -j"$(nproc)" -- --no-print-directory >/dev/null
+# quiet when clean; compiler warnings (there should be none) and failures are shown
+log=build/build.log
+if ! cmake --build build -j"$(nproc)" -- --no-print-directory >"$log" 2>&1; then
+  cat "$log" >&2
+  echo "setup: build failed (log: $log)" >&2
+  exit 1
+fi
+if grep -q "warning:" "$log"; then
+  grep -A3 "warning:" "$log" >&2
+  echo "setup: the build has compiler warnings (log: $log)" >&2
+fi
 echo "setup: build/mpmbench is ready" >&2
