@@ -25,6 +25,7 @@ int ply_write_particles(const char *path, const Particles *p)
         fwrite(rec, sizeof rec, 1, f);
         fwrite(&m, sizeof m, 1, f);
     }
-    if (fclose(f) != 0) return mpm_error(MPM_EINPUT, "%s: write failed", path);
+    int bad = ferror(f); /* a short fwrite (disk full) shows here or at fclose */
+    if (fclose(f) != 0 || bad) return mpm_error(MPM_EINPUT, "%s: write failed", path);
     return MPM_OK;
 }

@@ -21,6 +21,32 @@ check "every step converged" awk -F, 'NR>1 && $14!="converged"{bad=1} END{exit b
 check "frames.csv has one row" test "$(wc -l <"$tmp/run/frames.csv")" -eq 2
 check "run.json written" grep -q '"solver": "pn-pcg"' "$tmp/run/run.json"
 
+# --particles: one binary PLY per frame with position, velocity, material id
+"$bin" run --scene drop --solver pn-pcg --frames 2 --quiet --out "$tmp/plyrun" --particles "$tmp/ply"
+check "run with --particles exit 0" test $? -eq 0
+check "one PLY per frame" test -f "$tmp/ply/frame_0001.ply" -a -f "$tmp/ply/frame_0002.ply" -a ! -e "$tmp/ply/frame_0003.ply"
+python3 - "$tmp/ply/frame_0002.ply" "$tmp/plyrun/steps.csv" >"$tmp/ply.check" 2>&1 <<'PY'
+import csv, struct, sys
+data = open(sys.argv[1], "rb").read()
+head, body = data.split(b"end_header\n", 1)
+lines = head.decode().splitlines()
+assert lines[0] == "ply" and lines[1] == "format binary_little_endian 1.0", lines[:2]
+n = int([l for l in lines if l.startswith("element vertex")][0].split()[2])
+props = [l.split()[2] for l in lines if l.startswith("property")]
+assert props == ["x", "y", "z", "vx", "vy", "vz", "material"], props
+steps = list(csv.DictReader(open(sys.argv[2])))
+assert n == int(steps[-1]["particles"]), (n, steps[-1]["particles"])
+assert len(body) == n * 28, (len(body), n)
+recs = [struct.unpack_from("<6fi", body, 28 * k) for k in range(n)]
+ys = [r[1] for r in recs]
+# the box starts at y in [0.2, 0.4] and falls: after 2 frames it is lower, still above the ground
+assert 0.1 < min(ys) < 0.2 and max(ys) < 0.4, (min(ys), max(ys))
+assert all(r[4] < 0 for r in recs[:100]), "falling particles move down"
+assert {r[6] for r in recs} == {0}, "one material"
+print("ok")
+PY
+check "PLY header, count and contents ($(tail -1 "$tmp/ply.check"))" grep -qx ok "$tmp/ply.check"
+
 # run.json records every option the solver consulted with the value in effect
 "$bin" run --scene stretched-box --scale 3.6 --solver hot --solver-opt embedding=quadratic --frames 1 --quiet \
   --out "$tmp/hotq-opt"
