@@ -47,6 +47,15 @@ print("ok")
 PY
 check "PLY header, count and contents ($(tail -1 "$tmp/ply.check"))" grep -qx ok "$tmp/ply.check"
 
+# bench: a table, then one key=value line per figure, all positive
+"$bin" bench all --scene drop --threads 2 >"$tmp/bench.out" 2>&1
+check "bench exit 0" test $? -eq 0
+for key in spmv_gbs stream_gbs spmv_stream_ratio assemble_particles_per_s p2g_particles_per_s threads; do
+  check "bench reports $key > 0" awk -F= -v k="$key" '$1 == k && $2 + 0 > 0 {found = 1} END {exit !found}' "$tmp/bench.out"
+done
+check "bench: particles of drop" grep -qx "particles=6938" "$tmp/bench.out"
+expect_input_error "bench.*frobnicate|unknown" bench frobnicate --scene drop
+
 # run.json records every option the solver consulted with the value in effect
 "$bin" run --scene stretched-box --scale 3.6 --solver hot --solver-opt embedding=quadratic --frames 1 --quiet \
   --out "$tmp/hotq-opt"
