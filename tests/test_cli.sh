@@ -47,6 +47,18 @@ print("ok")
 PY
 check "PLY header, count and contents ($(tail -1 "$tmp/ply.check"))" grep -qx ok "$tmp/ply.check"
 
+# progress: a line with frame, step, iteration and ETA on a terminal only
+"$bin" run --scene drop --solver pn-pcg --frames 1 --out "$tmp/quiet" >/dev/null 2>"$tmp/pipe.err"
+check "no progress into a pipe" test ! -s "$tmp/pipe.err"
+if command -v script >/dev/null; then
+  env -u CI script -qc "'$bin' run --scene drop --solver pn-pcg --frames 1 --out '$tmp/tty'" /dev/null >"$tmp/tty.out"
+  check "progress on a terminal" grep -q "frame 1/1  step 0  iter 0  residual .* ETA" "$tmp/tty.out"
+  CI=1 script -qc "'$bin' run --scene drop --solver pn-pcg --frames 1 --out '$tmp/tty-ci'" /dev/null >"$tmp/tty-ci.out"
+  check "no progress with CI set" bash -c "! grep -q ETA '$tmp/tty-ci.out'"
+else
+  echo "progress on a terminal: no 'script' command, skipped"
+fi
+
 # bench: a table, then one key=value line per figure, all positive
 "$bin" bench all --scene drop --threads 2 >"$tmp/bench.out" 2>&1
 check "bench exit 0" test $? -eq 0
