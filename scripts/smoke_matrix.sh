@@ -6,7 +6,11 @@
 # it with --solvers all to check that every preset runs every scene.
 #
 # usage: scripts/smoke_matrix.sh [--bin PATH] [--solvers "a b"|all]
-#            [--frames F] [--out DIR] [--threads T]
+#            [--frames F] [--out DIR] [--threads T] [--asset-dir DIR]
+#
+# --asset-dir DIR (the folder with the original meshes, e.g.
+# ../shared/data/meshes) adds the mesh variants armacat-soft-mesh,
+# armacat-stiff-mesh, wheel-mesh and sauce-mesh.
 #
 # Frames: one per scene, except where the action starts later: Boards runs 12
 # (the sand reaches the top board after about 0.2 s) and Sauce 24 at a finer
@@ -23,6 +27,7 @@ solvers=hot
 frames=""
 out=""
 threads=${OMP_NUM_THREADS:-2}
+asset_dir=""
 die() { echo "smoke_matrix: $*" >&2; exit 2; }
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -31,6 +36,7 @@ while [ $# -gt 0 ]; do
     --frames) frames=${2:?--frames needs a number}; shift 2 ;;
     --out) out=${2:?--out needs a directory}; shift 2 ;;
     --threads) threads=${2:?--threads needs a number}; shift 2 ;;
+    --asset-dir) asset_dir=${2:?--asset-dir needs a directory}; shift 2 ;;
     *) die "unknown argument '$1'" ;;
   esac
 done
@@ -47,9 +53,16 @@ echo "scene,solver,scale,frames,exit,steps,not_converged,outer_iters,linear_iter
 fails=0
 runs=0
 # scene, the --scale giving about 4k particles ((Table 2 count / 4000)^(1/3)), frames
-for entry in "drop 1 1" "bar3 4.3 1" "stretched-box 3.6 1" "twist 3.9 1" "boxes 5.9 1" "donut 4 1" \
-             "armacat-soft 4.7 1" "armacat-stiff 4.7 1" "chain 4.3 1" "boards 3.6 12" "wheel 5.2 1" "faceless 3 1" \
-             "sauce 2.5 24"; do
+entries=("drop 1 1" "bar3 4.3 1" "stretched-box 3.6 1" "twist 3.9 1" "boxes 5.9 1" "donut 4 1"
+         "armacat-soft 4.7 1" "armacat-stiff 4.7 1" "chain 4.3 1" "boards 3.6 12" "wheel 5.2 1" "faceless 3 1"
+         "sauce 2.5 24")
+asset_args=()
+if [ -n "$asset_dir" ]; then
+  [ -d "$asset_dir" ] || die "--asset-dir $asset_dir: not a directory"
+  entries+=("armacat-soft-mesh 4.7 1" "armacat-stiff-mesh 4.7 1" "wheel-mesh 5.2 1" "sauce-mesh 2.5 24")
+  asset_args=(--asset-dir "$asset_dir")
+fi
+for entry in "${entries[@]}"; do
   set -- $entry
   scene=$1
   scale=$2
@@ -60,6 +73,7 @@ for entry in "drop 1 1" "bar3 4.3 1" "stretched-box 3.6 1" "twist 3.9 1" "boxes 
     mkdir -p "$out/$scene"
     start=$(date +%s.%N)
     "$bin" run --scene "$scene" --solver "$solver" --scale "$scale" --frames "$scene_frames" --threads "$threads" \
+      "${asset_args[@]}" \
       --quiet --out "$dir" >"$dir.log" 2>&1
     code=$?
     wall=$(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN {printf "%.2f", b - a}')
