@@ -20,16 +20,15 @@ struct StepProblem;
 
 /* Free-form options (`--solver-opt key=value`), shared by all parts. Every
  * lookup records the key it asked for with the value in effect (given or
- * default) and marks a given key used, so that after a solver is created
- *  - a key nobody asked for is reported as unknown (a typo must not run
- *    silently with the default; cf. PETSc's -options_left), and
+ * default), so that after a solver is created
+ *  - a given key nobody asked for is reported as unknown (a typo must not
+ *    run silently with the default; cf. PETSc's -options_left), and
  *  - the effective options can be written beside the results (run.json). */
 #define SOLVER_MAX_OPTS 32
 typedef struct {
     int n;
     char key[SOLVER_MAX_OPTS][32];
     char value[SOLVER_MAX_OPTS][64];
-    unsigned char used[SOLVER_MAX_OPTS];
     int n_asked;                         /* distinct keys looked up */
     char asked[SOLVER_MAX_OPTS][32];
     char asked_value[SOLVER_MAX_OPTS][64]; /* value in effect */

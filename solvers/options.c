@@ -5,17 +5,22 @@
 #include "core/error.h"
 #include "solvers/inverse_approx.h"
 
-/* Index of key in o (marked used), -1 when absent; records key with the
- * value in effect (the given one, else def_text). */
+static int asked_index(const SolverOptions *o, const char *key)
+{
+    for (int a = 0; a < o->n_asked; ++a)
+        if (strcmp(o->asked[a], key) == 0) return a;
+    return -1;
+}
+
+/* Index of key in o, -1 when absent; records key with the value in effect
+ * (the given one, else def_text). */
 static int lookup(SolverOptions *o, const char *key, const char *def_text)
 {
     int i = 0;
     while (i < o->n && strcmp(o->key[i], key) != 0) ++i;
     if (i == o->n) i = -1;
-    else o->used[i] = 1;
-    int a = 0;
-    while (a < o->n_asked && strcmp(o->asked[a], key) != 0) ++a;
-    if (a == o->n_asked && a < SOLVER_MAX_OPTS) {
+    int a = o->n_asked;
+    if (asked_index(o, key) < 0 && a < SOLVER_MAX_OPTS) {
         o->n_asked++;
         snprintf(o->asked[a], sizeof o->asked[0], "%s", key);
         snprintf(o->asked_value[a], sizeof o->asked_value[0], "%s", i >= 0 ? o->value[i] : def_text);
@@ -49,7 +54,7 @@ const char *solver_opt_string(SolverOptions *o, const char *key, const char *def
 int solver_opts_check_used(const SolverOptions *o, const char *who)
 {
     for (int i = 0; i < o->n; ++i) {
-        if (o->used[i]) continue;
+        if (asked_index(o, o->key[i]) >= 0) continue;
         char known[512] = "";
         size_t len = 0;
         for (int k = 0; k < o->n_asked && len < sizeof known; ++k)
