@@ -181,16 +181,15 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
             SolveStats ss;
             StepInfo si;
             if ((status = run_step(&sim, solver, &set, &work, iter_hook, &hook, &ss, &si))) goto done;
-            double wall = si.wall_s;
             fprintf(steps_csv, "%s,%s,%d,%d,%.9g,%.9g,%zu,%d,%lld,%d,%ld,%d,%.6e,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d\n",
                     scene.name, preset->name, frame, fsteps, si.t, si.dt, sim.p.n, si.active_nodes,
                     (long long)ss.hessian_blocks, ss.outer_iters, ss.linear_iters, ss.ls_evals, ss.residual,
-                    solve_status_name(ss.status), wall, si.begin_s, ss.assemble_s, ss.setup_s, ss.solve_s,
+                    solve_status_name(ss.status), si.wall_s, si.begin_s, ss.assemble_s, ss.setup_s, ss.solve_s,
                     ss.linesearch_s, si.end_s, threads);
             fsteps++;
             fouter += ss.outer_iters;
             flinear += ss.linear_iters;
-            fwall += wall;
+            fwall += si.wall_s;
             if (ss.residual > fmaxres) fmaxres = ss.residual;
             fstatus = worse(fstatus, ss.status);
         }

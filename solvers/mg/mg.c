@@ -50,7 +50,7 @@ typedef struct {
     CoarseJacobi cj;
     MgInfo info;
     int rediscretize;            /* baseline GMG: coarse levels from particles */
-    int gmg_bc_project;          /* GMG: project coarse residuals at coarse Dirichlet nodes */
+    int gmg_bc_project;          /* GMG only: project coarse residuals at coarse Dirichlet nodes */
     GmgLevel gl[MG_MAX_LEVELS];  /* their particle copies and grids */
 } Mg;
 
@@ -63,7 +63,6 @@ static int cj_apply(InvApprox *self, const double *r, double *z)
 static const InvApproxOps coarse_jacobi_ops = {"mg-coarse-jacobi", NULL, NULL, cj_apply, NULL};
 
 static void level_spmv(const void *ctx, const double *x, double *y) { bsr_spmv((const Bsr *)ctx, x, y); }
-
 
 static int level_reserve(MgLevel *L, int n, int own_diag)
 {
@@ -252,7 +251,7 @@ static void smooth(Mg *M, int l, int from_zero, int last_residual)
 static void restrict_level(const Mg *M, int l, const double *fine, double *coarse)
 {
     mg_restrict(&M->lev[l].T, fine, coarse);
-    if (M->rediscretize && M->gmg_bc_project) problem_project(&M->gl[l + 1].pb, coarse);
+    if (M->gmg_bc_project) problem_project(&M->gl[l + 1].pb, coarse);
 }
 
 static int mg_apply(InvApprox *self, const double *in, double *out)
