@@ -174,6 +174,18 @@ double collider_max_speed(const Collider *c, double t, const double lo[3], const
     return vmax;
 }
 
+int collider_friction(const double normal[3], const double v_col[3], double mu, double jn, double v[3])
+{
+    if (!(jn > 0.0) || !(mu > 0.0)) return 0;
+    double rel[3] = {v[0] - v_col[0], v[1] - v_col[1], v[2] - v_col[2]};
+    double vn = v3_dot(rel, normal);
+    double t[3] = {rel[0] - vn * normal[0], rel[1] - vn * normal[1], rel[2] - vn * normal[2]};
+    double speed = v3_norm(t), drop = mu * jn;
+    double keep = speed > drop ? 1.0 - drop / speed : 0.0;
+    for (int d = 0; d < 3; ++d) v[d] = v_col[d] + vn * normal[d] + keep * t[d];
+    return keep > 0.0 ? 1 : 2;
+}
+
 void collider_free(Collider *c)
 {
     if (!c) return;
@@ -263,11 +275,26 @@ static int parse_motion(json_t *j, const char *file, const char *path, Collider 
     return MPM_OK;
 }
 
+/* "friction": mu >= 0, only on slip colliders. */
+static int parse_friction(json_t *j, const char *file, const char *path, Collider *c)
+{
+    int have = 0;
+    int st = sj_number(j, "friction", 0, file, path, &c->friction, &have);
+    if (st || !have) return st;
+    if (!(c->friction >= 0.0) || !isfinite(c->friction))
+        return sj_bad_number(file, path, "friction", "expected a non-negative number", c->friction);
+    if (c->friction > 0.0 && c->kind != COLLIDER_SLIP)
+        return sj_bad_number(file, path, "friction",
+                             "expected 0 on a sticky collider (friction applies to \"type\": \"slip\")",
+                             c->friction);
+    return MPM_OK;
+}
+
 int collider_parse_named(json_t *j, const char *file, const char *jpath, const char *asset_dir, double dx,
                          const char *default_name, Collider *out)
 {
     static const char *const keys[] = {"name",        "type",          "shape",     "pivot", "motion",
-                                       "oscillation", "material_velocity", "cfl_speed", NULL};
+                                       "oscillation", "material_velocity", "cfl_speed", "friction", NULL};
     Collider c;
     memset(&c, 0, sizeof c);
     memset(out, 0, sizeof *out);
@@ -305,6 +332,10 @@ int collider_parse_named(json_t *j, const char *file, const char *jpath, const c
     }
     if (have_cfl && !(c.cfl_speed >= 0)) {
         st = sj_bad_number(file, jpath, "cfl_speed", "expected a non-negative number", c.cfl_speed);
+        collider_free(&c);
+        return st;
+    }
+    if ((st = parse_friction(j, file, jpath, &c))) {
         collider_free(&c);
         return st;
     }

@@ -19,7 +19,13 @@
  *    "motion": [phase, ...]}              optional, default: static forever
  *    "oscillation": {...},                optional, see below
  *    "material_velocity": [vx, vy, vz],   optional, default 0
- *    "cfl_speed": s}                      optional
+ *    "cfl_speed": s,                      optional
+ *    "friction": mu}                      optional, default 0: Coulomb
+ *                                         friction coefficient (>= 0) of a
+ *                                         "slip" collider (a sticky one
+ *                                         already takes the collider's
+ *                                         velocity; friction > 0 there is an
+ *                                         error), see collider_friction
  *   phase = {"until": t_end,              seconds, absolute time; omit or null
  *                                         only on the last phase (= forever)
  *            "velocity": [vx, vy, vz],     m/s, default 0
@@ -86,6 +92,7 @@ typedef struct Collider {
     double osc_amp[3], osc_omega[3], osc_phase[3]; /* m, rad/s, rad */
     double material_vel[3]; /* rest frame, m/s */
     double cfl_speed;      /* < 0: report the material speed (default) */
+    double friction;       /* Coulomb coefficient mu of a slip collider (0: frictionless) */
 } Collider;
 
 /* Parses one collider object. `file`/`jpath` name it in error messages
@@ -123,6 +130,24 @@ int collider_active(const Collider *c, double t);
  * world bounds when they overlap, else [lo, hi] itself. 0 when inactive;
  * "cfl_speed" when the collider has one. */
 double collider_max_speed(const Collider *c, double t, const double lo[3], const double hi[3]);
+
+/* Coulomb friction at one grid node, applied to the grid velocity v^{n+1}
+ * after the solve and before G2P (Stomakhin et al. 2013 section 8 applies it
+ * to the grid velocities in its collision step; Gast et al. 2015 sections
+ * 5.1 and 6.2 apply it after the Newton solve, with the collision impulse
+ * taken from the solve): with the relative velocity v_rel = v - v_col split
+ * into its normal part (v_rel.n) n and tangential part v_t, and jn >= 0 the
+ * normal collision impulse per unit mass (a velocity; for a node of a slip
+ * collider, the normal component of the unconstrained gradient at the
+ * solution divided by the node mass, the velocity change the constraint
+ * made),
+ *     v_t <- max(0, 1 - mu jn / |v_t|) v_t
+ * (Gast eq. in section 5.1), i.e. |v_t| drops by exactly mu jn, or to 0
+ * (sticking) if |v_t| <= mu jn; the normal part is untouched. jn <= 0 (the
+ * constraint pulls, no contact pressure) leaves v alone. v is updated in
+ * place. Returns 0 (untouched), 1 (tangential speed reduced) or 2 (stuck).
+ * The relative kinetic energy 1/2 |v_rel|^2 never increases. */
+int collider_friction(const double normal[3], const double v_col[3], double mu, double jn, double v[3]);
 
 void collider_free(Collider *c);
 

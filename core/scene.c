@@ -14,6 +14,7 @@
 
 #include "core/error.h"
 #include "core/mat3.h"
+#include "core/noise.h"
 #include "core/rng.h"
 #include "core/sampler.h"
 #include "core/source.h"
@@ -113,13 +114,15 @@ int scene_list(SceneListFn fn, void *ctx)
 
 /* Optional fields that --set may create when absent, by context. */
 static const char *const k_top_optional[] = {"description", "cfl",       "max_dt",  "apic_ratio", "domain_walls",
-                                             "seed",        "colliders", "sources", NULL};
+                                             "seed",        "colliders", "sources", "transfer",   "flip_alpha",
+                                             "position_update", "particle_volume", NULL};
 static const char *const k_mat_optional[] = {"plasticity", NULL};
 static const char *const k_plast_optional[] = {"yield_stress", "theta_c", "theta_s", "hardening",
                                                "min_Jp",       "max_Jp",  NULL};
-static const char *const k_obj_optional[] = {"name", "sampling", "velocity", "initial_F", "surface_particles", NULL};
+static const char *const k_obj_optional[] = {"name",      "sampling",          "velocity", "initial_F",
+                                             "variation", "surface_particles", NULL};
 static const char *const k_col_optional[] = {"name",        "type",              "pivot",     "motion",
-                                             "oscillation", "material_velocity", "cfl_speed", NULL};
+                                             "oscillation", "material_velocity", "cfl_speed", "friction", NULL};
 static const char *const k_src_optional[] = {"name",        "from",     "until",           "pivot", "motion",
                                              "oscillation", "collider", "particle_volume", NULL};
 
@@ -313,7 +316,53 @@ typedef struct {
     int F_per_particle;
     size_t surf_n;   /* surface particles (after --scale) */
     Shape *surf_mesh; /* "vertices_of": take (a subset of) its vertices; else surface samples */
+    int has_variation; /* "variation": clumpy density (and snow pre-compaction) */
+    double var_amplitude, var_length;
+    uint64_t var_seed;
 } ObjectSpec;
+
+/* "variation": {"amplitude": a in [0, 1), "length": L > 0, "seed": s}. */
+static int parse_variation(json_t *j, const char *file, const char *path, uint64_t default_seed, ObjectSpec *o)
+{
+    static const char *const keys[] = {"amplitude", "length", "seed", NULL};
+    int st = sj_check_object(j, file, path, keys);
+    if (st) return st;
+    if ((st = sj_number(j, "amplitude", 1, file, path, &o->var_amplitude, NULL))) return st;
+    if (!(o->var_amplitude >= 0.0 && o->var_amplitude < 1.0))
+        return sj_bad_number(file, path, "amplitude", "expected a number in [0, 1)", o->var_amplitude);
+    if ((st = sj_positive(j, "length", 1, file, path, &o->var_length, NULL))) return st;
+    if (!isfinite(o->var_length))
+        return sj_bad_number(file, path, "length", "expected a positive finite length [m]", o->var_length);
+    o->var_seed = default_seed;
+    json_t *sj = json_object_get(j, "seed");
+    if (sj) {
+        if (!json_is_integer(sj) || json_integer_value(sj) < 0)
+            return sj_bad(file, path, "seed", "expected a non-negative integer", sj);
+        o->var_seed = (uint64_t)json_integer_value(sj);
+    }
+    o->has_variation = 1;
+    return MPM_OK;
+}
+
+/* Applies each object's "variation" to its particles (after sampling and
+ * after the plastic state exists): mass *= 1 + a nu(x); for snow with
+ * hardening J_p = 1 / (1 + a nu(x)), the plastic compaction that gives that
+ * density. */
+static void apply_variations(Scene *sc, const ObjectSpec *objs, int nobj)
+{
+    Particles *P = &sc->particles;
+    for (int i = 0; i < nobj; ++i) {
+        const ObjectSpec *o = &objs[i];
+        if (!o->has_variation) continue;
+        const Material *m = &sc->materials[o->mat];
+        int compact = P->Jp && m->plasticity == PLASTICITY_SNOW && m->hardening != 0.0;
+        for (size_t k = sc->object_offsets[i]; k < sc->object_offsets[i + 1]; ++k) {
+            double ratio = 1.0 + o->var_amplitude * value_noise3(o->var_seed, o->var_length, P->x + 3 * k);
+            P->mass[k] *= ratio;
+            if (compact) P->Jp[k] = 1.0 / ratio;
+        }
+    }
+}
 
 /* "surface_particles": {"count": N} | {"vertices_of": mesh shape}. */
 static int parse_surface(json_t *j, const char *file, const char *path, const char *asset_dir, double dx,
@@ -377,8 +426,8 @@ static int parse_initial_F(json_t *j, const char *file, const char *path, uint64
 static int parse_object(json_t *j, const char *file, const char *path, uint64_t index, const Scene *sc,
                         const char *asset_dir, double scale, ObjectSpec *o)
 {
-    static const char *const keys[] = {"name",     "material",  "shape",          "ppc", "sampling",
-                                       "velocity", "initial_F", "surface_particles", NULL};
+    static const char *const keys[] = {"name",      "material",  "shape",          "ppc", "sampling",
+                                       "velocity",  "initial_F", "surface_particles", "variation", NULL};
     int st = sj_check_object(j, file, path, keys);
     if (st) return st;
     const char *s = NULL;
@@ -423,6 +472,12 @@ static int parse_object(json_t *j, const char *file, const char *path, uint64_t 
         char fp[512];
         sj_path(fp, sizeof fp, path, "initial_F");
         if ((st = parse_initial_F(fj, file, fp, rng_mix(sc->seed, 0xF000ull + index), o))) return st;
+    }
+    json_t *vj = json_object_get(j, "variation");
+    if (vj) {
+        char vp[512];
+        sj_path(vp, sizeof vp, path, "variation");
+        if ((st = parse_variation(vj, file, vp, rng_mix(sc->seed, 0xC100ull + index), o))) return st;
     }
     if ((st = shape_parse(sh, file, sp, asset_dir, sc->dx, &o->shape))) return st;
     json_t *surf = json_object_get(j, "surface_particles");
@@ -644,12 +699,58 @@ static int parse_sources(Scene *sc, json_t *srcs, const char *file, const char *
  * Top level
  * ====================================================================== */
 
+/* The MPM variants of Gast et al. 2015 section 6 (each off by default):
+ * "transfer", "flip_alpha", "position_update", "particle_volume". */
+static int parse_mpm_options(json_t *root, const char *file, Scene *sc)
+{
+    int st, have = 0;
+    const char *s = NULL;
+    sc->transfer = TRANSFER_APIC;
+    if ((st = sj_string(root, "transfer", 0, file, "", &s, &have))) return st;
+    if (have) {
+        if (strcmp(s, "pic_flip") == 0)
+            sc->transfer = TRANSFER_PIC_FLIP;
+        else if (strcmp(s, "apic") != 0)
+            return sj_bad(file, "", "transfer", "expected \"apic\" or \"pic_flip\"", json_object_get(root, "transfer"));
+    }
+    sc->flip_alpha = 0.95; /* Gast 6.1 step 5: "We typically used alpha = 0.95" */
+    if ((st = sj_number(root, "flip_alpha", 0, file, "", &sc->flip_alpha, &have))) return st;
+    if (have && sc->transfer != TRANSFER_PIC_FLIP)
+        return sj_bad_number(file, "", "flip_alpha", "expected no flip_alpha unless \"transfer\" is \"pic_flip\"",
+                             sc->flip_alpha);
+    if (!(sc->flip_alpha >= 0 && sc->flip_alpha <= 1))
+        return sj_bad_number(file, "", "flip_alpha", "expected a number in [0, 1]", sc->flip_alpha);
+    if (sc->transfer == TRANSFER_PIC_FLIP && json_object_get(root, "apic_ratio"))
+        return sj_bad_number(file, "", "apic_ratio", "expected no apic_ratio with \"transfer\": \"pic_flip\" (C_p = 0)",
+                             sc->apic_ratio);
+    sc->position_update = POSITION_FORWARD_EULER;
+    if ((st = sj_string(root, "position_update", 0, file, "", &s, &have))) return st;
+    if (have) {
+        if (strcmp(s, "backward_euler") == 0)
+            sc->position_update = POSITION_BACKWARD_EULER;
+        else if (strcmp(s, "forward_euler") != 0)
+            return sj_bad(file, "", "position_update", "expected \"forward_euler\" or \"backward_euler\"",
+                          json_object_get(root, "position_update"));
+    }
+    sc->volumes_from_density = 0;
+    if ((st = sj_string(root, "particle_volume", 0, file, "", &s, &have))) return st;
+    if (have) {
+        if (strcmp(s, "grid_density") == 0)
+            sc->volumes_from_density = 1;
+        else if (strcmp(s, "shape") != 0)
+            return sj_bad(file, "", "particle_volume", "expected \"shape\" or \"grid_density\"",
+                          json_object_get(root, "particle_volume"));
+    }
+    return MPM_OK;
+}
+
 static int build(json_t *root, const char *file, const SceneLoadOptions *opt, const char *asset_dir, Scene *sc)
 {
     static const char *const keys[] = {"name",       "description", "dx",     "fps",          "frames",
                                        "cfl",        "max_dt",      "gravity", "apic_ratio",  "domain",
                                        "domain_walls", "seed",      "materials", "objects",   "colliders",
-                                       "sources",    NULL};
+                                       "sources",    "transfer",    "flip_alpha", "position_update",
+                                       "particle_volume", NULL};
     int st = sj_check_object(root, file, "", keys);
     if (st) return st;
     if ((st = read_name(root, "name", 1, file, "", sc->name, sizeof sc->name))) return st;
@@ -681,6 +782,7 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
     if ((st = sj_number(root, "apic_ratio", 0, file, "", &sc->apic_ratio, NULL))) return st;
     if (!(sc->apic_ratio >= 0 && sc->apic_ratio <= 1))
         return sj_bad_number(file, "", "apic_ratio", "expected a number in [0, 1]", sc->apic_ratio);
+    if ((st = parse_mpm_options(root, file, sc))) return st;
 
     json_t *dom = json_object_get(root, "domain");
     if (!dom) return mpm_error(MPM_EINPUT, "%s: domain: missing required field", file);
@@ -771,6 +873,7 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
             snow |= sc->materials[k].plasticity == PLASTICITY_SNOW && sc->materials[k].hardening != 0.0;
         if (snow) st = particles_enable_plastic_state(&sc->particles); /* only hardening reads Jp */
     }
+    if (!st) apply_variations(sc, spec, (int)nobj);
     for (size_t i = 0; i < nobj; ++i) {
         shape_free(spec[i].shape);
         shape_free(spec[i].surf_mesh);

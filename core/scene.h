@@ -14,7 +14,30 @@
  *   "max_dt": 0.0208333,              optional (default 1/fps), > 0
  *   "gravity": [0, -9.8, 0],          required, m/s^2
  *   "apic_ratio": 1,                  optional (default 1): APIC/RPIC blend r in
- *                                     [0, 1]; 1 = APIC, 0 = RPIC
+ *                                     [0, 1]; 1 = APIC, 0 = RPIC (only with
+ *                                     "transfer": "apic")
+ *   "transfer": "apic",               optional: "apic" (default, APIC/RPIC) |
+ *                                     "pic_flip": v_p = alpha v_FLIP +
+ *                                     (1 - alpha) v_PIC and C_p = 0
+ *                                     (Stomakhin et al. 2013; Gast et al.
+ *                                     2015 section 6.1 step 5), see
+ *                                     core/transfer.h
+ *   "flip_alpha": 0.95,               optional, only with "pic_flip": alpha in
+ *                                     [0, 1] (default 0.95, Gast's value;
+ *                                     0 = PIC, 1 = FLIP)
+ *   "position_update": "forward_euler",
+ *                                     optional: "forward_euler" (default,
+ *                                     x_p += dt v_PIC) | "backward_euler":
+ *                                     x_p^{n+1} = x_p^n + dt v(x_p^{n+1}) by
+ *                                     per-particle Newton (Gast 2015 section
+ *                                     6.3, core/position_update.h)
+ *   "particle_volume": "shape",       optional: "shape" (default, see
+ *                                     "Particles" below) | "grid_density":
+ *                                     at the first step V_p = m_p / rho_p with
+ *                                     rho_p = sum_i w_ip m_i / dx^3 (Gast 2015
+ *                                     section 6.1 step 2; core/transfer.h);
+ *                                     particles emitted later keep their
+ *                                     source's volume
  *   "domain": {"min": [..], "max": [..]},   required; every particle must lie
  *                                     in it (max > min on every axis)
  *   "domain_walls": true,             optional (default false): adds six sticky
@@ -52,6 +75,21 @@
  *                                     per particle (default) or one for the
  *                                     whole object; seed defaults to one
  *                                     derived from the scene seed
+ *      "variation": {"amplitude": 0.1, "length": 0.02, "seed": 5}
+ *                                     optional: a clumpy material. With the
+ *                                     smooth value noise nu(x) in [-1, 1] of
+ *                                     correlation length "length" [m] > 0
+ *                                     (core/noise.h), each particle's mass
+ *                                     (density) is scaled by
+ *                                     1 + amplitude nu(x_p), 0 <= amplitude
+ *                                     < 1; if the material is snow with
+ *                                     hardening, the particle also starts
+ *                                     pre-compacted, J_p = 1 / (1 + amplitude
+ *                                     nu) (the density ratio), so its Lame
+ *                                     parameters are scaled by
+ *                                     exp(xi (1 - J_p)): denser clumps are
+ *                                     stiffer. "seed" (integer >= 0) defaults
+ *                                     to one derived from the scene seed.
  *      "surface_particles": {"count": N} | {"vertices_of": {mesh shape}}
  *                                     optional: extra particles on the
  *                                     surface, standing in for the
@@ -102,7 +140,9 @@
 #include "core/collider.h"
 #include "core/material.h"
 #include "core/particles.h"
+#include "core/position_update.h"
 #include "core/source.h"
+#include "core/transfer.h"
 
 typedef struct {
     const char *key;
@@ -125,6 +165,10 @@ typedef struct Scene {
     double fps, cfl, max_dt;          /* cfl default 0.6, max_dt default 1/fps */
     double gravity[3];
     double apic_ratio;                /* RPIC/APIC blend r (1 = APIC, 0 = RPIC) */
+    TransferKind transfer;            /* "transfer": APIC (default) or PIC/FLIP */
+    double flip_alpha;                /* "flip_alpha" (PIC/FLIP only) */
+    PositionUpdateKind position_update; /* "position_update" */
+    int volumes_from_density;         /* "particle_volume": "grid_density" */
     double domain_lo[3], domain_hi[3];
     Material *materials;              /* declaration order */
     int n_materials;

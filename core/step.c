@@ -27,6 +27,89 @@ static int copy_particles(Particles *dst, const Particles *src)
     return MPM_OK;
 }
 
+/* ---- Gast et al. 2015 section 6 options (scene fields, off by default) ---- */
+
+static int scene_has_friction(const Scene *sc)
+{
+    for (int c = 0; c < sc->n_colliders; ++c)
+        if (sc->colliders[c].kind == COLLIDER_SLIP && sc->colliders[c].friction > 0.0) return 1;
+    return 0;
+}
+
+/* Coulomb friction at slip-collider nodes after the solve, on the grid
+ * velocity v^{n+1} before G2P (collider_friction; Stomakhin et al. 2013
+ * section 8, Gast et al. 2015 sections 5.1 and 6.2). The normal impulse is
+ * the collision impulse of the solve: at the constrained minimiser dv* the
+ * unconstrained gradient g_i of E at a slip node is the impulse the
+ * constraint applied (Gast 5.1: dt f_col = grad E' - grad E, the projected
+ * gradient being ~0), so jn = g_i.n / m_i. problem_gradient projects only
+ * when the problem has Dirichlet nodes, hence n_dirichlet is set to 0 around
+ * the call (and restored). */
+static int apply_collider_friction(Simulation *sim, const double *dv)
+{
+    const Scene *sc = sim->scene;
+    StepProblem *pb = &sim->pb;
+    Grid *g = &sim->grid;
+    if (!sim->has_friction || pb->n_dirichlet == 0) return MPM_OK;
+    if (g->n > sim->cap_grad) {
+        int cap = g->n + g->n / 4 + 256;
+        double *q = realloc(sim->grad, sizeof(double) * 3 * (size_t)cap);
+        if (!q) return mpm_error(MPM_EINTERNAL, "out of memory: friction gradient");
+        sim->grad = q;
+        sim->cap_grad = cap;
+    }
+    int nd = pb->n_dirichlet;
+    pb->n_dirichlet = 0;
+    problem_energy(pb, dv);
+    problem_gradient(pb, dv, sim->grad);
+    pb->n_dirichlet = nd;
+    const double t = sim->t, dx = g->dx;
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < g->n; ++i) {
+        if (pb->bc[i] != BC_SLIP) continue;
+        double x[3] = {g->coord[3 * i] * dx, g->coord[3 * i + 1] * dx, g->coord[3 * i + 2] * dx};
+        for (int c = 0; c < sc->n_colliders; ++c) {
+            const Collider *col = &sc->colliders[c];
+            if (col->kind != COLLIDER_SLIP || !(col->friction > 0.0) || !collider_active(col, t)) continue;
+            double n[3], vc[3];
+            if (collider_phi(col, t, x, n) > 0.0) continue;
+            collider_velocity(col, t, x, vc);
+            const double *gi = sim->grad + 3 * (size_t)i;
+            double jn = (gi[0] * n[0] + gi[1] * n[1] + gi[2] * n[2]) / g->mass[i];
+            collider_friction(n, vc, col->friction, jn, sim->vnew + 3 * (size_t)i);
+        }
+    }
+    return MPM_OK;
+}
+
+/* G2P and the position update the scene chose. The default (APIC,
+ * forward Euler) is the original call, so existing scenes are unchanged. */
+static void grid_to_particles(Simulation *sim)
+{
+    const Scene *sc = sim->scene;
+    if (sc->transfer == TRANSFER_APIC && sc->position_update == POSITION_FORWARD_EULER) {
+        transfer_g2p(&sim->grid, &sim->st, &sim->p, sim->vnew, sim->dt, sc->apic_ratio);
+        return;
+    }
+    G2POptions opt = {.kind = sc->transfer,
+                      .apic_ratio = sc->apic_ratio,
+                      .flip_alpha = sc->flip_alpha,
+                      .advect = sc->position_update == POSITION_FORWARD_EULER};
+    transfer_g2p_opts(&sim->grid, &sim->st, &sim->p, sim->vnew, sim->dt, &opt);
+    if (sc->position_update == POSITION_BACKWARD_EULER)
+        position_update_backward_euler(&sim->grid, &sim->st, &sim->p, sim->vnew, sim->dt, &sim->pos_stats);
+}
+
+/* Gast et al. 2015 section 6.1 step 2, first step only, after the P2G. */
+static void estimate_volumes(Simulation *sim)
+{
+    if (!sim->scene->volumes_from_density || sim->volumes_done) return;
+    transfer_volumes_from_density(&sim->grid, &sim->st, &sim->p);
+    sim->volumes_done = 1;
+}
+
+/* ---- end of the section 6 options ---- */
+
 int sim_init(Simulation *sim, const Scene *scene)
 {
     memset(sim, 0, sizeof *sim);
@@ -40,6 +123,7 @@ int sim_init(Simulation *sim, const Scene *scene)
         if (mt->plasticity == PLASTICITY_SNOW && mt->hardening != 0.0 && (st = particles_enable_plastic_state(&sim->p)))
             return st;
     }
+    sim->has_friction = scene_has_friction(scene);
     return MPM_OK;
 }
 
@@ -50,6 +134,7 @@ void sim_free(Simulation *sim)
     stencils_free(&sim->st);
     problem_free(&sim->pb);
     free(sim->vnew);
+    free(sim->grad);
     memset(sim, 0, sizeof *sim);
 }
 
@@ -123,6 +208,7 @@ int step_begin(Simulation *sim)
     sim->dt = sim_next_dt(sim);
     if ((st = grid_build(&sim->grid, &sim->st, &sim->p, sc->dx))) return st;
     transfer_p2g(&sim->grid, &sim->st, &sim->p);
+    estimate_volumes(sim);
     if ((st = problem_prepare(&sim->pb, &sim->grid, &sim->st, &sim->p, sc->materials, sc->n_materials, sim->dt,
                               sc->gravity)))
         return st;
@@ -144,7 +230,9 @@ int step_end(Simulation *sim, const double *dv)
     /* v^{n+1} = v^n + dv*, the iterate at which the stopping rule held (SPEC 2 item 5) */
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < 3 * (size_t)g->n; ++k) sim->vnew[k] = g->v[k] + dv[k];
-    transfer_g2p(g, &sim->st, &sim->p, sim->vnew, sim->dt, sc->apic_ratio);
+    int fst = apply_collider_friction(sim, dv);
+    if (fst) return fst;
+    grid_to_particles(sim);
     if (sc->needs_plasticity) {
         int st = plasticity_apply(&sim->p, sc->materials, sc->n_materials);
         if (st) return st;

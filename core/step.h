@@ -1,12 +1,17 @@
 /* The two halves of a timestep around the solve (SPEC 2; DESIGN data flow):
  *   step_begin: colliders at t^n, dt from CFL and frame boundaries, particle
  *               sort, sparse grid, P2G, Dirichlet nodes, the step problem;
- *   step_end:   v^{n+1} = v^n + dv, G2P (APIC/RPIC, F update, advection),
- *               plasticity (lagged), domain and finiteness checks. */
+ *   step_end:   v^{n+1} = v^n + dv, Coulomb friction at slip colliders,
+ *               G2P (APIC/RPIC or PIC/FLIP, F update, forward-Euler
+ *               advection or the backward-Euler position update),
+ *               plasticity (lagged), domain and finiteness checks.
+ * The first step_begin also estimates particle volumes from the grid
+ * density when the scene asks ("particle_volume": "grid_density"). */
 #ifndef MPM_STEP_H
 #define MPM_STEP_H
 
 #include "core/grid.h"
+#include "core/position_update.h"
 #include "core/problem.h"
 #include "core/scene.h"
 
@@ -23,6 +28,12 @@ typedef struct {
     double dt;            /* current step */
     double *vnew;
     int cap_nodes;
+    /* Gast et al. 2015 section 6 options (scene fields, off by default) */
+    int has_friction;     /* some slip collider has friction > 0 */
+    double *grad;         /* friction: unconstrained gradient at dv* (cap_grad nodes) */
+    int cap_grad;
+    int volumes_done;     /* "particle_volume": "grid_density" applied (first step) */
+    PositionUpdateStats pos_stats; /* last step's backward-Euler position update */
 } Simulation;
 
 int sim_init(Simulation *sim, const Scene *scene);

@@ -1,5 +1,7 @@
 /* Particle <-> grid transfers with APIC and the RPIC blend (SPEC 2;
- * Jiang et al. 2015; HOT reference §1.2). */
+ * Jiang et al. 2015; HOT reference §1.2), the PIC/FLIP blend of Stomakhin
+ * et al. 2013 / Gast et al. 2015 section 6.1 step 5, and the particle volumes
+ * estimated from the grid density (Gast et al. 2015 section 6.1 step 2). */
 #ifndef MPM_TRANSFER_H
 #define MPM_TRANSFER_H
 
@@ -10,11 +12,43 @@
  * v_i = (mv)_i / m_i. Race-free by particle-block colouring. */
 void transfer_p2g(Grid *g, const Stencils *st, const Particles *p);
 
-/* G2P with weights at x_p^n, grid velocities vnew (3n):
- *   v_p = sum w v_i,  B_p = sum w v_i (x_i - x_p)^T,  C' = 4/dx^2 B_p,
- *   C_p = (r+1)/2 C' + (r-1)/2 C'^T   (r = apic_ratio; 1 APIC, 0 RPIC),
- *   grad v_p = sum v_i grad w^T,  x_p += dt v_p,  F_p <- (I + dt grad v_p) F_p. */
+/* Which particle velocity G2P stores. */
+typedef enum {
+    TRANSFER_APIC = 0,    /* APIC/RPIC: v_p = PIC velocity, C_p from B_p (apic_ratio) */
+    TRANSFER_PIC_FLIP = 1 /* v_p = alpha v_FLIP + (1 - alpha) v_PIC, C_p = 0 */
+} TransferKind;
+
+typedef struct {
+    TransferKind kind;
+    double apic_ratio; /* TRANSFER_APIC: r in [0, 1] (1 APIC, 0 RPIC) */
+    double flip_alpha; /* TRANSFER_PIC_FLIP: alpha in [0, 1] (0 = PIC, 1 = FLIP; Gast uses 0.95) */
+    int advect;        /* 1: x_p += dt v_PIC (forward Euler); 0: positions untouched (the caller
+                          moves them, e.g. position_update_backward_euler) */
+} G2POptions;
+
+/* G2P with weights at x_p^n, grid velocities vnew (3n), v^n = g->v:
+ *   v_PIC = sum w v_i,  grad v_p = sum v_i grad w^T,  F_p <- (I + dt grad v_p) F_p,
+ *   APIC:     v_p = v_PIC, B_p = sum w v_i (x_i - x_p)^T, C' = 4/dx^2 B_p,
+ *             C_p = (r+1)/2 C' + (r-1)/2 C'^T,
+ *   PIC/FLIP: v_p = alpha (v_p^n + sum w (v_i - v_i^n)) + (1 - alpha) v_PIC, C_p = 0
+ *             (Stomakhin 2013 has no affine term, so P2G gets none; the F
+ *             update is the same in both modes, Gast 6.1 step 4),
+ *   advect:   x_p += dt v_PIC in both modes (Gast 6.3: positions move with
+ *             the PIC velocity even where FLIP is stored). */
+void transfer_g2p_opts(const Grid *g, const Stencils *st, Particles *p, const double *vnew, double dt,
+                       const G2POptions *opt);
+
+/* APIC/RPIC G2P with forward-Euler advection (transfer_g2p_opts with
+ * kind APIC, advect 1). */
 void transfer_g2p(const Grid *g, const Stencils *st, Particles *p, const double *vnew, double dt,
                   double apic_ratio);
+
+/* Particle volumes from the grid density (Gast et al. 2015 section 6.1 step
+ * 2, after Stomakhin et al. 2013): with the masses m_i of a P2G at the
+ * particles' current positions, rho_i = m_i / dx^3, rho_p = sum_i w_ip rho_i
+ * and V_p = m_p / rho_p. On a uniform lattice of ppc particles per cell this
+ * gives V_p = dx^3 / ppc wherever the lattice covers the particle's whole
+ * stencil neighbourhood; near a free surface rho_p is lower and V_p larger. */
+void transfer_volumes_from_density(const Grid *g, const Stencils *st, Particles *p);
 
 #endif

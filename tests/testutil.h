@@ -26,4 +26,10 @@ double test_uniform(unsigned long long *state, double lo, double hi);
 
 int test_summary(const char *name);
 
+struct Scene;
+/* Writes `json` to a temporary file, loads it as a scene with scale `scale`
+ * and the given --set overrides (key, value pairs; n_set of them), removes
+ * the file. Returns scene_load's status. */
+int test_scene_from_text(const char *json, double scale, const char *const *set, int n_set, struct Scene *out);
+
 #endif
