@@ -114,8 +114,8 @@ int scene_list(SceneListFn fn, void *ctx)
 
 /* Optional fields that --set may create when absent, by context. */
 static const char *const k_top_optional[] = {"description", "cfl",       "max_dt",  "apic_ratio", "domain_walls",
-                                             "seed",        "colliders", "sources", "transfer",   "flip_alpha",
-                                             "position_update", "particle_volume", NULL};
+                                             "seed",        "colliders", "sources", "transfer",   "position_update",
+                                             "particle_volume", NULL};
 static const char *const k_mat_optional[] = {"plasticity", NULL};
 static const char *const k_plast_optional[] = {"yield_stress", "theta_c", "theta_s", "hardening",
                                                "min_Jp",       "max_Jp",  NULL};
@@ -700,29 +700,32 @@ static int parse_sources(Scene *sc, json_t *srcs, const char *file, const char *
  * ====================================================================== */
 
 /* The MPM variants of Gast et al. 2015 section 6 (each off by default):
- * "transfer", "flip_alpha", "position_update", "particle_volume". */
+ * "transfer", "position_update", "particle_volume". */
 static int parse_mpm_options(json_t *root, const char *file, Scene *sc)
 {
     int st, have = 0;
     const char *s = NULL;
     sc->transfer = TRANSFER_APIC;
-    if ((st = sj_string(root, "transfer", 0, file, "", &s, &have))) return st;
-    if (have) {
-        if (strcmp(s, "pic_flip") == 0)
-            sc->transfer = TRANSFER_PIC_FLIP;
-        else if (strcmp(s, "apic") != 0)
-            return sj_bad(file, "", "transfer", "expected \"apic\" or \"pic_flip\"", json_object_get(root, "transfer"));
-    }
     sc->flip_alpha = 0.95; /* Gast 6.1 step 5: "We typically used alpha = 0.95" */
-    if ((st = sj_number(root, "flip_alpha", 0, file, "", &sc->flip_alpha, &have))) return st;
-    if (have && sc->transfer != TRANSFER_PIC_FLIP)
-        return sj_bad_number(file, "", "flip_alpha", "expected no flip_alpha unless \"transfer\" is \"pic_flip\"",
-                             sc->flip_alpha);
-    if (!(sc->flip_alpha >= 0 && sc->flip_alpha <= 1))
-        return sj_bad_number(file, "", "flip_alpha", "expected a number in [0, 1]", sc->flip_alpha);
-    if (sc->transfer == TRANSFER_PIC_FLIP && json_object_get(root, "apic_ratio"))
-        return sj_bad_number(file, "", "apic_ratio", "expected no apic_ratio with \"transfer\": \"pic_flip\" (C_p = 0)",
-                             sc->apic_ratio);
+    json_t *tj = json_object_get(root, "transfer");
+    if (tj && json_is_object(tj)) {
+        static const char *const tkeys[] = {"type", "alpha", NULL};
+        if ((st = sj_check_object(tj, file, "transfer", tkeys))) return st;
+        if ((st = sj_string(tj, "type", 1, file, "transfer", &s, NULL))) return st;
+        if (strcmp(s, "pic_flip") != 0)
+            return sj_bad(file, "transfer", "type", "expected \"pic_flip\" (the object form is for PIC/FLIP)",
+                          json_object_get(tj, "type"));
+        sc->transfer = TRANSFER_PIC_FLIP;
+        if ((st = sj_number(tj, "alpha", 0, file, "transfer", &sc->flip_alpha, NULL))) return st;
+        if (!(sc->flip_alpha >= 0 && sc->flip_alpha <= 1))
+            return sj_bad_number(file, "transfer", "alpha", "expected a number in [0, 1]", sc->flip_alpha);
+    } else if (tj) {
+        if (json_is_string(tj) && strcmp(json_string_value(tj), "pic_flip") == 0)
+            sc->transfer = TRANSFER_PIC_FLIP;
+        else if (!json_is_string(tj) || strcmp(json_string_value(tj), "apic") != 0)
+            return sj_bad(file, "", "transfer",
+                          "expected \"apic\", \"pic_flip\" or {\"type\": \"pic_flip\", \"alpha\": a}", tj);
+    }
     sc->position_update = POSITION_FORWARD_EULER;
     if ((st = sj_string(root, "position_update", 0, file, "", &s, &have))) return st;
     if (have) {
@@ -749,8 +752,7 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
     static const char *const keys[] = {"name",       "description", "dx",     "fps",          "frames",
                                        "cfl",        "max_dt",      "gravity", "apic_ratio",  "domain",
                                        "domain_walls", "seed",      "materials", "objects",   "colliders",
-                                       "sources",    "transfer",    "flip_alpha", "position_update",
-                                       "particle_volume", NULL};
+                                       "sources",    "transfer",    "position_update", "particle_volume", NULL};
     int st = sj_check_object(root, file, "", keys);
     if (st) return st;
     if ((st = read_name(root, "name", 1, file, "", sc->name, sizeof sc->name))) return st;

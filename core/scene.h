@@ -14,17 +14,18 @@
  *   "max_dt": 0.0208333,              optional (default 1/fps), > 0
  *   "gravity": [0, -9.8, 0],          required, m/s^2
  *   "apic_ratio": 1,                  optional (default 1): APIC/RPIC blend r in
- *                                     [0, 1]; 1 = APIC, 0 = RPIC (only with
- *                                     "transfer": "apic")
+ *                                     [0, 1]; 1 = APIC, 0 = RPIC. Read by the
+ *                                     APIC transfer only (PIC/FLIP keeps no
+ *                                     affine matrix), so "transfer" can be
+ *                                     switched with --set on any scene
  *   "transfer": "apic",               optional: "apic" (default, APIC/RPIC) |
- *                                     "pic_flip": v_p = alpha v_FLIP +
+ *                                     "pic_flip" | {"type": "pic_flip",
+ *                                     "alpha": 0.95}: v_p = alpha v_FLIP +
  *                                     (1 - alpha) v_PIC and C_p = 0
  *                                     (Stomakhin et al. 2013; Gast et al.
- *                                     2015 section 6.1 step 5), see
- *                                     core/transfer.h
- *   "flip_alpha": 0.95,               optional, only with "pic_flip": alpha in
- *                                     [0, 1] (default 0.95, Gast's value;
- *                                     0 = PIC, 1 = FLIP)
+ *                                     2015 section 6.1 step 5), alpha in
+ *                                     [0, 1], default 0.95 (Gast's value;
+ *                                     0 = PIC, 1 = FLIP), see core/transfer.h
  *   "position_update": "forward_euler",
  *                                     optional: "forward_euler" (default,
  *                                     x_p += dt v_PIC) | "backward_euler":
@@ -166,7 +167,7 @@ typedef struct Scene {
     double gravity[3];
     double apic_ratio;                /* RPIC/APIC blend r (1 = APIC, 0 = RPIC) */
     TransferKind transfer;            /* "transfer": APIC (default) or PIC/FLIP */
-    double flip_alpha;                /* "flip_alpha" (PIC/FLIP only) */
+    double flip_alpha;                /* "transfer".alpha (PIC/FLIP only) */
     PositionUpdateKind position_update; /* "position_update" */
     int volumes_from_density;         /* "particle_volume": "grid_density" */
     double domain_lo[3], domain_hi[3];

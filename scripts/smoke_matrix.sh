@@ -15,7 +15,8 @@
 # Frames: one per scene, except where the action starts later: Boards runs 12
 # (the sand reaches the top board after about 0.2 s) and Sauce 24 at a finer
 # scale (it starts empty; its source emits about 140 particles per frame
-# there). --frames F runs F frames of every scene instead.
+# there); the snowball scenes run until just after their impact (drop 13,
+# wall 10, collide 4). --frames F runs F frames of every scene instead.
 #
 # Output: one line per run on stdout, OUT/summary.csv (scene, solver, scale,
 # frames, exit code, steps, steps not converged, outer and linear iterations,
@@ -55,7 +56,7 @@ runs=0
 # scene, the --scale giving about 4k particles ((Table 2 count / 4000)^(1/3)), frames
 entries=("drop 1 1" "bar3 4.3 1" "stretched-box 3.6 1" "twist 3.9 1" "boxes 5.9 1" "donut 4 1"
          "armacat-soft 4.7 1" "armacat-stiff 4.7 1" "chain 4.3 1" "boards 3.6 12" "wheel 5.2 1" "faceless 3 1"
-         "sauce 2.5 24")
+         "sauce 2.5 24" "snowball-drop 4 13" "snowball-wall 4 10" "snowball-collide 5 4")
 asset_args=()
 if [ -n "$asset_dir" ]; then
   [ -d "$asset_dir" ] || die "--asset-dir $asset_dir: not a directory"
