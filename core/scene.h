@@ -58,6 +58,12 @@
  *                   | {"type": "snow", "theta_c": in (0,1), "theta_s": >= 0,
  *                      "hardening": >= 0 (default 0),
  *                      "min_Jp": (default 0), "max_Jp": (default 1e30)}
+ *                     snow (Stomakhin et al. 2013, as Gast et al. 2015 use
+ *                     it): singular values of the elastic F clamped to
+ *                     [1 - theta_c, 1 + theta_s] after each step, the
+ *                     plastic volume ratio J_p kept per particle, and mu,
+ *                     lambda scaled by exp(hardening (1 - J_p)) in the step
+ *                     problem (core/plasticity.h)
  *     }, ...
  *   },
  *   "objects": [                      required, at least one (may be empty
@@ -118,7 +124,8 @@
  * both particle sets, as in the reference). Rest volume V_p = shape volume /
  * number of particles (interior samples plus surface particles, as the
  * reference does for analytic shapes with .obj vertices), mass =
- * density V_p, C = 0, F = I unless initial_F. Surface particles come first
+ * density V_p (times 1 + amplitude nu(x_p) with "variation"), C = 0,
+ * F = I unless initial_F. Surface particles come first
  * in each object (the reference prepends the vertices).
  *
  * Overrides (--set key=value) are applied to the JSON tree before validation.

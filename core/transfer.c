@@ -118,7 +118,7 @@ void transfer_volumes_from_density(const Grid *g, const Stencils *st, Particles 
         double wm = 0.0;
         for (int s = 0; s < MPM_STENCIL; ++s)
             if (node[s] >= 0) wm += w[s] * g->mass[node[s]];
-        /* wm >= w_pp-node * m_p > 0: the particle's own mass is in every node of its stencil */
+        /* wm > 0: m_i >= w_ip m_p (the particle's own share), so wm >= m_p sum_i w_ip^2 */
         p->vol[k] = p->mass[k] * cell / wm;
     }
 }

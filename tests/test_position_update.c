@@ -177,9 +177,51 @@ static void test_field(void)
     fixture_free(&f);
 }
 
+/* A rough random field (dt |grad v| of order 1, CFL 1): full Newton steps
+ * overshoot for some particles, and the halving rule keeps every particle's
+ * residual ||x - x^n - dt v(x)|| from growing (it starts at dt |v(x^n)|). */
+static void test_rough_field(void)
+{
+    FixtureOptions o;
+    fixture_default(&o);
+    o.per_axis = 12;
+    Fixture f;
+    CHECK(fixture_build(&f, &o) == 0, "fixture");
+    int n = f.g.n;
+    double *vel = malloc(sizeof(double) * 3 * (size_t)n), V = 1.0, dt = f.g.dx / V;
+    unsigned long long rs = 2024;
+    for (int i = 0; i < 3 * n; ++i) vel[i] = V * test_uniform(&rs, -1, 1);
+    size_t np = f.p.n;
+    double *x0 = malloc(sizeof(double) * 3 * np);
+    memcpy(x0, f.p.x, sizeof(double) * 3 * np);
+    PositionUpdateStats ps;
+    position_update_backward_euler(&f.g, &f.st, &f.p, vel, dt, &ps);
+    size_t grew = 0;
+    double worst = 0;
+    for (size_t k = 0; k < np; ++k) {
+        double v[3], G[9], r[3];
+        grid_velocity_at(&f.g, vel, x0 + 3 * k, NULL, NULL, v, G);
+        double r0 = dt * sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        grid_velocity_at(&f.g, vel, f.p.x + 3 * k, NULL, NULL, v, G);
+        for (int d = 0; d < 3; ++d) r[d] = f.p.x[3 * k + d] - x0[3 * k + d] - dt * v[d];
+        double r1 = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+        worst = fmax(worst, r1 / f.g.dx);
+        grew += r1 > r0 * (1 + 1e-12);
+    }
+    printf("rough field: %ld Newton iterations over %zu particles (max %d), %ld halvings, %zu unconverged, "
+           "%zu residuals grew, largest final residual %.2e dx\n",
+           ps.newton_iters, np, ps.max_newton_iters, ps.halvings, ps.unconverged, grew, worst);
+    CHECK(ps.halvings > 0, "the field should need step halvings");
+    CHECK(grew == 0, "%zu particles ended with a larger residual than they started with", grew);
+    free(x0);
+    free(vel);
+    fixture_free(&f);
+}
+
 int main(void)
 {
     test_sticky_ground();
     test_field();
+    test_rough_field();
     return test_summary("test_position_update");
 }

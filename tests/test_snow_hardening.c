@@ -12,8 +12,9 @@
  *  - compressing every particle past theta_c (F = 0.9 I, clamped to
  *    0.975 I) lowers J_p by 0.729 / 0.975^3 and the next step's Lame
  *    parameters grow by exactly exp(xi (J_p,old - J_p,new));
- *  - the noise lies in [-1, 1], is deterministic, changes with the seed and
- *    is continuous (|nu(x + h) - nu(x)| <= 3 |h| / L);
+ *  - the noise lies in [-1, 1], is deterministic, changes with the seed, is
+ *    continuous (|nu(x + h) - nu(x)| <= 3 |h| / L) and flat across its
+ *    lattice planes (C^1);
  *  - without hardening, variation changes masses only (no plastic state). */
 #include <math.h>
 #include <stdlib.h>
@@ -53,7 +54,19 @@ static void test_noise(void)
         double y[3] = {x[0] + 1e-4, x[1] - 1e-4, x[2] + 1e-4};
         worst_slope = fmax(worst_slope, fabs(value_noise3(7, 0.3, y) - v) / (sqrt(3) * 1e-4) * 0.3);
     }
-    printf("noise: range [%.3f, %.3f], mean %.3f, largest slope %.2f / L\n", lo, hi, mean, worst_slope);
+    /* C^1: the smoothstep weights have zero slope on the lattice planes, so
+     * nu is flat across them (a trilinear blend would have a kink there) */
+    double worst_kink = 0;
+    for (int k = 0; k < 2000; ++k) {
+        double x[3];
+        for (int d = 0; d < 3; ++d) x[d] = test_uniform(&rs, -3, 3);
+        x[0] = 0.3 * floor(x[0] / 0.3);
+        double a[3] = {x[0] - 3e-5, x[1], x[2]}, b[3] = {x[0] + 3e-5, x[1], x[2]};
+        worst_kink = fmax(worst_kink, fabs(value_noise3(7, 0.3, b) - value_noise3(7, 0.3, a)));
+    }
+    printf("noise: range [%.3f, %.3f], mean %.3f, largest slope %.2f / L, change across lattice planes %.1e\n", lo,
+           hi, mean, worst_slope, worst_kink);
+    CHECK(worst_kink < 1e-6, "noise not flat across lattice planes: %g", worst_kink);
     CHECK(lo >= -1 && hi <= 1 && lo < -0.7 && hi > 0.7, "range [%g, %g]", lo, hi);
     CHECK(fabs(mean) < 0.05, "mean %g", mean);
     CHECK(same && differ > n - 10, "deterministic (%d), seed-dependent (%d of %d)", same, differ, n);
