@@ -50,6 +50,24 @@ int particles_push(Particles *p, const double x[3], const double v[3], double ma
     return MPM_OK;
 }
 
+int particles_copy(Particles *dst, const Particles *src)
+{
+    int st = particles_reserve(dst, src->n);
+    if (st) return st;
+    if (src->Jp && (st = particles_enable_plastic_state(dst))) return st;
+    size_t n = src->n;
+    memcpy(dst->x, src->x, sizeof(double) * 3 * n);
+    memcpy(dst->v, src->v, sizeof(double) * 3 * n);
+    memcpy(dst->C, src->C, sizeof(double) * 9 * n);
+    memcpy(dst->F, src->F, sizeof(double) * 9 * n);
+    memcpy(dst->mass, src->mass, sizeof(double) * n);
+    memcpy(dst->vol, src->vol, sizeof(double) * n);
+    memcpy(dst->mat, src->mat, sizeof(int) * n);
+    if (src->Jp) memcpy(dst->Jp, src->Jp, sizeof(double) * n);
+    dst->n = n;
+    return MPM_OK;
+}
+
 int particles_enable_plastic_state(Particles *p)
 {
     if (p->Jp) return MPM_OK;

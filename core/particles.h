@@ -23,6 +23,9 @@ int particles_reserve(Particles *p, size_t cap);
 int particles_push(Particles *p, const double x[3], const double v[3], double mass, double vol, int mat);
 /* Allocates the plastic state array (Jp = 1) if absent. */
 int particles_enable_plastic_state(Particles *p);
+/* Copies src into dst (grown as needed; dst's plastic state is allocated
+ * when src has one). */
+int particles_copy(Particles *dst, const Particles *src);
 /* Reorders particles: new index k holds old particle perm[k]. `scratch` must
  * hold 9n doubles. */
 void particles_permute(Particles *p, const size_t *perm, double *scratch);

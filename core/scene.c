@@ -321,6 +321,18 @@ typedef struct {
     uint64_t var_seed;
 } ObjectSpec;
 
+/* Optional "seed": a non-negative integer, else `default_seed`. */
+static int parse_seed(json_t *j, const char *file, const char *path, uint64_t default_seed, uint64_t *out)
+{
+    *out = default_seed;
+    json_t *sj = json_object_get(j, "seed");
+    if (!sj) return MPM_OK;
+    if (!json_is_integer(sj) || json_integer_value(sj) < 0)
+        return sj_bad(file, path, "seed", "expected a non-negative integer", sj);
+    *out = (uint64_t)json_integer_value(sj);
+    return MPM_OK;
+}
+
 /* "variation": {"amplitude": a in [0, 1), "length": L > 0, "seed": s}. */
 static int parse_variation(json_t *j, const char *file, const char *path, uint64_t default_seed, ObjectSpec *o)
 {
@@ -333,13 +345,7 @@ static int parse_variation(json_t *j, const char *file, const char *path, uint64
     if ((st = sj_positive(j, "length", 1, file, path, &o->var_length, NULL))) return st;
     if (!isfinite(o->var_length))
         return sj_bad_number(file, path, "length", "expected a positive finite length [m]", o->var_length);
-    o->var_seed = default_seed;
-    json_t *sj = json_object_get(j, "seed");
-    if (sj) {
-        if (!json_is_integer(sj) || json_integer_value(sj) < 0)
-            return sj_bad(file, path, "seed", "expected a non-negative integer", sj);
-        o->var_seed = (uint64_t)json_integer_value(sj);
-    }
+    if ((st = parse_seed(j, file, path, default_seed, &o->var_seed))) return st;
     o->has_variation = 1;
     return MPM_OK;
 }
@@ -410,13 +416,7 @@ static int parse_initial_F(json_t *j, const char *file, const char *path, uint64
     if ((st = sj_positive(j, "min", 1, file, path, &o->F_min, NULL))) return st;
     if ((st = sj_number(j, "max", 1, file, path, &o->F_max, NULL))) return st;
     if (!(o->F_max >= o->F_min)) return sj_bad_number(file, path, "max", "expected a number >= min", o->F_max);
-    o->F_seed = default_seed;
-    json_t *sj = json_object_get(j, "seed");
-    if (sj) {
-        if (!json_is_integer(sj) || json_integer_value(sj) < 0)
-            return sj_bad(file, path, "seed", "expected a non-negative integer", sj);
-        o->F_seed = (uint64_t)json_integer_value(sj);
-    }
+    if ((st = parse_seed(j, file, path, default_seed, &o->F_seed))) return st;
     o->F_per_particle = 1;
     if ((st = sj_bool(j, "per_particle", 0, file, path, &o->F_per_particle, NULL))) return st;
     o->has_F = 1;

@@ -9,21 +9,15 @@
 #include "core/plasticity.h"
 #include "core/transfer.h"
 
-static int copy_particles(Particles *dst, const Particles *src)
+/* Grows a 3-per-node buffer to hold n nodes (with slack), keeping it otherwise. */
+static int grow_node_buffer(double **buf, int *cap, int n, const char *what)
 {
-    int st = particles_reserve(dst, src->n);
-    if (st) return st;
-    if (src->Jp && (st = particles_enable_plastic_state(dst))) return st;
-    size_t n = src->n;
-    memcpy(dst->x, src->x, sizeof(double) * 3 * n);
-    memcpy(dst->v, src->v, sizeof(double) * 3 * n);
-    memcpy(dst->C, src->C, sizeof(double) * 9 * n);
-    memcpy(dst->F, src->F, sizeof(double) * 9 * n);
-    memcpy(dst->mass, src->mass, sizeof(double) * n);
-    memcpy(dst->vol, src->vol, sizeof(double) * n);
-    memcpy(dst->mat, src->mat, sizeof(int) * n);
-    if (src->Jp) memcpy(dst->Jp, src->Jp, sizeof(double) * n);
-    dst->n = n;
+    if (n <= *cap) return MPM_OK;
+    int c = n + n / 4 + 256;
+    double *q = realloc(*buf, sizeof(double) * 3 * (size_t)c);
+    if (!q) return mpm_error(MPM_EINTERNAL, "out of memory: %s", what);
+    *buf = q;
+    *cap = c;
     return MPM_OK;
 }
 
@@ -51,13 +45,8 @@ static int apply_collider_friction(Simulation *sim, const double *dv)
     StepProblem *pb = &sim->pb;
     Grid *g = &sim->grid;
     if (!sim->has_friction || pb->n_dirichlet == 0) return MPM_OK;
-    if (g->n > sim->cap_grad) {
-        int cap = g->n + g->n / 4 + 256;
-        double *q = realloc(sim->grad, sizeof(double) * 3 * (size_t)cap);
-        if (!q) return mpm_error(MPM_EINTERNAL, "out of memory: friction gradient");
-        sim->grad = q;
-        sim->cap_grad = cap;
-    }
+    int st = grow_node_buffer(&sim->grad, &sim->cap_grad, g->n, "friction gradient");
+    if (st) return st;
     int nd = pb->n_dirichlet;
     pb->n_dirichlet = 0;
     problem_energy(pb, dv);
@@ -115,7 +104,7 @@ int sim_init(Simulation *sim, const Scene *scene)
     memset(sim, 0, sizeof *sim);
     sim->scene = scene;
     sim->frame_dt = 1.0 / scene->fps;
-    int st = copy_particles(&sim->p, &scene->particles);
+    int st = particles_copy(&sim->p, &scene->particles);
     if (st) return st;
     /* per-particle plastic state only where a material reads it (snow hardening) */
     for (int m = 0; m < scene->n_materials; ++m) {
@@ -220,13 +209,8 @@ int step_end(Simulation *sim, const double *dv)
 {
     const Scene *sc = sim->scene;
     Grid *g = &sim->grid;
-    if (g->n > sim->cap_nodes) {
-        int cap = g->n + g->n / 4 + 256;
-        double *v = realloc(sim->vnew, sizeof(double) * 3 * (size_t)cap);
-        if (!v) return mpm_error(MPM_EINTERNAL, "out of memory: grid velocities");
-        sim->vnew = v;
-        sim->cap_nodes = cap;
-    }
+    int gst = grow_node_buffer(&sim->vnew, &sim->cap_nodes, g->n, "grid velocities");
+    if (gst) return gst;
     /* v^{n+1} = v^n + dv*, the iterate at which the stopping rule held (SPEC 2 item 5) */
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < 3 * (size_t)g->n; ++k) sim->vnew[k] = g->v[k] + dv[k];

@@ -15,19 +15,10 @@
 #include "tests/fixture.h"
 #include "tests/testutil.h"
 
-static void copy_particles(Particles *dst, const Particles *src)
+static void copy_into(Particles *dst, const Particles *src)
 {
     memset(dst, 0, sizeof *dst);
-    particles_reserve(dst, src->n);
-    size_t n = src->n;
-    memcpy(dst->x, src->x, sizeof(double) * 3 * n);
-    memcpy(dst->v, src->v, sizeof(double) * 3 * n);
-    memcpy(dst->C, src->C, sizeof(double) * 9 * n);
-    memcpy(dst->F, src->F, sizeof(double) * 9 * n);
-    memcpy(dst->mass, src->mass, sizeof(double) * n);
-    memcpy(dst->vol, src->vol, sizeof(double) * n);
-    memcpy(dst->mat, src->mat, sizeof(int) * n);
-    dst->n = n;
+    particles_copy(dst, src);
 }
 
 /* max_k |a_k - b_k| over 3n entries, relative to max |b| */
@@ -76,12 +67,12 @@ int main(void)
         }
     }
     Particles apic, p0, p1, pb, still, dflt;
-    copy_particles(&apic, &f.p);
-    copy_particles(&p0, &f.p);
-    copy_particles(&p1, &f.p);
-    copy_particles(&pb, &f.p);
-    copy_particles(&still, &f.p);
-    copy_particles(&dflt, &f.p);
+    copy_into(&apic, &f.p);
+    copy_into(&p0, &f.p);
+    copy_into(&p1, &f.p);
+    copy_into(&pb, &f.p);
+    copy_into(&still, &f.p);
+    copy_into(&dflt, &f.p);
     G2POptions oa = {TRANSFER_APIC, 1.0, 0.0, 1};
     G2POptions o0 = {TRANSFER_PIC_FLIP, 1.0, 0.0, 1}, o1 = {TRANSFER_PIC_FLIP, 1.0, 1.0, 1},
                ob = {TRANSFER_PIC_FLIP, 1.0, 0.95, 1}, os = {TRANSFER_PIC_FLIP, 1.0, 0.95, 0};
