@@ -133,9 +133,9 @@ double collider_max_speed(const Collider *c, double t, const double lo[3], const
 
 /* Coulomb friction at one grid node, applied to the grid velocity v^{n+1}
  * after the solve and before G2P (Stomakhin et al. 2013 section 8 applies it
- * to the grid velocities in its collision step; Gast et al. 2015 sections
- * 5.1 and 6.2 apply it after the Newton solve, with the collision impulse
- * taken from the solve): with the relative velocity v_rel = v - v_col split
+ * to the grid velocities in its collision step; Gast et al. 2015 section
+ * 5.1 applies it after the Newton solve, with the collision impulse taken
+ * from the solve): with the relative velocity v_rel = v - v_col split
  * into its normal part (v_rel.n) n and tangential part v_t, and jn >= 0 the
  * normal collision impulse per unit mass (a velocity; for a node of a slip
  * collider, the normal component of the unconstrained gradient at the

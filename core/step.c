@@ -32,7 +32,7 @@ static int scene_has_friction(const Scene *sc)
 
 /* Coulomb friction at slip-collider nodes after the solve, on the grid
  * velocity v^{n+1} before G2P (collider_friction; Stomakhin et al. 2013
- * section 8, Gast et al. 2015 sections 5.1 and 6.2). The normal impulse is
+ * section 8, Gast et al. 2015 section 5.1). The normal impulse is
  * the collision impulse of the solve: at the constrained minimiser dv* the
  * unconstrained gradient g_i of E at a slip node is the impulse the
  * constraint applied (Gast 5.1: dt f_col = grad E' - grad E, the projected
