@@ -1,0 +1,449 @@
+/* Cells of an experiment matrix: expansion, ids, command lines, validation
+ * (matrix_cells.h). */
+#include "experiments/matrix_cells.h"
+
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "core/scene.h"
+#include "experiments/registry.h"
+#include "solvers/solver.h"
+
+/* Replaces the recorded message by "prefix: message", keeping the status. */
+static int wrap_error(int status, const char *prefix)
+{
+    char msg[1024];
+    snprintf(msg, sizeof msg, "%s", mpm_last_error());
+    mpm_clear_error();
+    return mpm_error(status, "%s: %s", prefix, msg);
+}
+
+/* src on top of dst (src wins); MPM_EINPUT past MATRIX_MAX_KV keys. */
+static int kv_merge(const Matrix *m, const char *scene, MatrixKvList *dst, const MatrixKvList *src)
+{
+    for (int i = 0; i < src->n; ++i) {
+        int slot = -1;
+        for (int k = 0; k < dst->n; ++k)
+            if (!strcmp(dst->kv[k].key, src->kv[i].key)) slot = k;
+        if (slot < 0) {
+            if (dst->n >= MATRIX_MAX_KV)
+                return mpm_error(MPM_EINPUT, "%s: %s: a cell of scene \"%s\" gets more than %d set/solver_opts entries",
+                                 m->base, src->kv[i].origin, scene, MATRIX_MAX_KV);
+            slot = dst->n++;
+        }
+        dst->kv[slot] = src->kv[i];
+    }
+    return MPM_OK;
+}
+
+static int cmp_kv(const void *a, const void *b) { return strcmp(((const MatrixKv *)a)->key, ((const MatrixKv *)b)->key); }
+
+static uint64_t fnv1a64(const char *s)
+{
+    uint64_t h = 1469598103934665603ULL;
+    for (; *s; ++s) {
+        h ^= (unsigned char)*s;
+        h *= 1099511628211ULL;
+    }
+    return h;
+}
+
+static json_t *kv_object(const MatrixKv *kv, int n)
+{
+    json_t *o = json_object();
+    for (int i = 0; i < n; ++i) json_object_set_new(o, kv[i].key, json_string(kv[i].value));
+    return o;
+}
+
+/* The canonical serialisation and the id derived from it. */
+static int cell_identify(MatrixCell *c)
+{
+    json_t *o = json_pack("{s:s, s:s, s:f, s:f, s:i, s:i, s:i, s:b, s:b, s:b, s:o, s:o}", "scene", c->scene, "solver",
+                          c->solver, "eps", c->eps, "scale", c->scale, "threads", c->threads, "frames", c->frames,
+                          "first_timed_frame", c->first_timed_frame, "history", c->history, "armijo", c->armijo,
+                          "particles", c->particles, "set", kv_object(c->set, c->n_set), "solver_opts",
+                          kv_object(c->solver_opts, c->n_solver_opts));
+    if (!o) return mpm_error(MPM_EINTERNAL, "out of memory (cell settings)");
+    c->canonical = json_dumps(o, JSON_SORT_KEYS | JSON_COMPACT | JSON_REAL_PRECISION(17));
+    json_decref(o);
+    if (!c->canonical) return mpm_error(MPM_EINTERNAL, "out of memory (cell settings)");
+    snprintf(c->id, sizeof c->id, "%012llx", (unsigned long long)(fnv1a64(c->canonical) & 0xffffffffffffULL));
+    return MPM_OK;
+}
+
+/* The cell's value of a rule key as text (string axes, labels) or number. */
+static int rule_value_matches(const Matrix *m, const MatrixCell *c, const char *key, json_t *v)
+{
+    if (!strcmp(key, "eps")) return json_number_value(v) == c->eps;
+    if (!strcmp(key, "scale")) return json_number_value(v) == c->scale;
+    if (!strcmp(key, "threads")) return json_integer_value(v) == c->threads;
+    char text[256];
+    if (json_is_number(v)) matrix_format_number(json_number_value(v), text, sizeof text);
+    else snprintf(text, sizeof text, "%s", json_string_value(v));
+    if (!strcmp(key, "scene")) return !strcmp(text, c->scene);
+    if (!strcmp(key, "solver")) return !strcmp(text, c->solver);
+    int a = matrix_named_index(m, key);
+    return a >= 0 && !strcmp(text, m->named[a].values[c->value[a]].label);
+}
+
+static int rule_matches(const Matrix *m, const MatrixCell *c, json_t *rule)
+{
+    const char *key;
+    json_t *v;
+    json_object_foreach(rule, key, v) {
+        int any = 0;
+        if (json_is_array(v)) {
+            for (size_t i = 0; i < json_array_size(v) && !any; ++i) any = rule_value_matches(m, c, key, json_array_get(v, i));
+        } else {
+            any = rule_value_matches(m, c, key, v);
+        }
+        if (!any) return 0;
+    }
+    return 1;
+}
+
+static int rules_keep(const Matrix *m, const MatrixCell *c)
+{
+    if (m->include) {
+        int any = 0;
+        for (size_t i = 0; i < json_array_size(m->include) && !any; ++i) any = rule_matches(m, c, json_array_get(m->include, i));
+        if (!any) return 0;
+    }
+    if (m->exclude)
+        for (size_t i = 0; i < json_array_size(m->exclude); ++i)
+            if (rule_matches(m, c, json_array_get(m->exclude, i))) return 0;
+    return 1;
+}
+
+static const MatrixSettings *scene_settings(const Matrix *m, const char *scene)
+{
+    for (int i = 0; i < m->n_per_scene; ++i)
+        if (!strcmp(m->per_scene[i].scene, scene)) return &m->per_scene[i].s;
+    return NULL;
+}
+
+static int copy_kv(const MatrixKvList *l, MatrixKv **out, int *n)
+{
+    *n = l->n;
+    *out = NULL;
+    if (!l->n) return MPM_OK;
+    if (!(*out = malloc(sizeof **out * (size_t)l->n))) return mpm_error(MPM_EINTERNAL, "out of memory");
+    memcpy(*out, l->kv, sizeof **out * (size_t)l->n);
+    qsort(*out, (size_t)l->n, sizeof **out, cmp_kv);
+    return MPM_OK;
+}
+
+/* The cell at one point of the product: idx[0..4] index scene, solver, eps,
+ * scale, threads (-1 = the defaults' value), idx[5+a] the named axis a. */
+static int build_cell(const Matrix *m, const int *idx, MatrixCell *c)
+{
+    const MatrixSettings *d = &m->defaults;
+    memset(c, 0, sizeof *c);
+    snprintf(c->scene, sizeof c->scene, "%s", idx[0] >= 0 ? m->scenes[idx[0]] : d->scene);
+    if (idx[0] >= 0) snprintf(c->scene_origin, sizeof c->scene_origin, "axes.scene[%d]", idx[0]);
+    else snprintf(c->scene_origin, sizeof c->scene_origin, "%s", d->scene_origin);
+    snprintf(c->solver, sizeof c->solver, "%s", idx[1] >= 0 ? m->solvers[idx[1]] : d->solver);
+    if (idx[1] >= 0) snprintf(c->solver_origin, sizeof c->solver_origin, "axes.solver[%d]", idx[1]);
+    else snprintf(c->solver_origin, sizeof c->solver_origin, "%s", d->solver_origin);
+    const MatrixSettings *ps = scene_settings(m, c->scene);
+    c->eps = d->has_eps ? d->eps : 1e-7;
+    c->scale = ps && ps->has_scale ? ps->scale : d->has_scale ? d->scale : 1.0;
+    c->threads = d->has_threads ? d->threads : 0;
+    c->frames = ps && ps->has_frames ? ps->frames : d->has_frames ? d->frames : 0;
+    c->first_timed_frame = ps && ps->has_first ? ps->first_timed_frame : d->has_first ? d->first_timed_frame : 0;
+    if (idx[2] >= 0) c->eps = m->eps[idx[2]];
+    if (idx[3] >= 0) c->scale = m->scales[idx[3]];
+    if (idx[4] >= 0) c->threads = m->threads[idx[4]];
+    c->history = d->history;
+    c->armijo = d->armijo;
+    c->particles = d->particles;
+    snprintf(c->asset_dir, sizeof c->asset_dir, "%s", d->has_asset_dir ? d->asset_dir : "");
+    c->timeout_s = m->cell_timeout_s;
+    MatrixKvList set = d->set, opts = d->solver_opts;
+    int st = ps ? kv_merge(m, c->scene, &set, &ps->set) : MPM_OK;
+    for (int a = 0; a < m->n_named && !st; ++a) {
+        c->value[a] = idx[5 + a];
+        const MatrixNamedValue *v = &m->named[a].values[idx[5 + a]];
+        st = kv_merge(m, c->scene, m->named[a].kind == MATRIX_SET ? &set : &opts, &v->kv);
+    }
+    if (st) return st;
+    if (c->frames > 0 && c->first_timed_frame >= c->frames)
+        return mpm_error(MPM_EINPUT, "%s: scene \"%s\": first_timed_frame %d is not before frames %d", m->base, c->scene,
+                         c->first_timed_frame, c->frames);
+    st = copy_kv(&set, &c->set, &c->n_set);
+    if (!st) st = copy_kv(&opts, &c->solver_opts, &c->n_solver_opts);
+    if (!st) st = cell_identify(c);
+    return st;
+}
+
+static void cell_release(MatrixCell *c)
+{
+    free(c->set);
+    free(c->solver_opts);
+    free(c->canonical);
+    memset(c, 0, sizeof *c);
+}
+
+int matrix_expand(const Matrix *m, MatrixCells *out)
+{
+    memset(out, 0, sizeof *out);
+    int n_axes = 5 + m->n_named;
+    int size[5 + MATRIX_MAX_AXES];
+    size[0] = m->n_scenes;
+    size[1] = m->n_solvers;
+    size[2] = m->n_eps;
+    size[3] = m->n_scales;
+    size[4] = m->n_threads;
+    for (int a = 0; a < m->n_named; ++a) size[5 + a] = m->named[a].n;
+    size_t total = 1;
+    for (int a = 0; a < n_axes; ++a) {
+        total *= (size_t)(size[a] > 0 ? size[a] : 1);
+        if (total > 1000000) return mpm_error(MPM_EINPUT, "%s: more than a million cells", m->base);
+    }
+    out->cells = calloc(total, sizeof *out->cells);
+    if (!out->cells) return mpm_error(MPM_EINTERNAL, "out of memory (%zu cells)", total);
+    int idx[5 + MATRIX_MAX_AXES];
+    for (int a = 0; a < n_axes; ++a) idx[a] = size[a] > 0 ? 0 : -1;
+    for (size_t k = 0; k < total; ++k) {
+        MatrixCell *c = &out->cells[out->n];
+        int st = build_cell(m, idx, c);
+        if (st) {
+            cell_release(c);
+            return st;
+        }
+        int keep = rules_keep(m, c);
+        for (int j = 0; j < out->n && keep; ++j) {
+            if (strcmp(out->cells[j].id, c->id)) continue;
+            if (strcmp(out->cells[j].canonical, c->canonical))
+                return mpm_error(MPM_EINTERNAL, "cell id %s names two different settings: %s and %s", c->id,
+                                 out->cells[j].canonical, c->canonical);
+            keep = 0; /* identical effective settings run once */
+        }
+        if (keep) out->n++;
+        else cell_release(c);
+        /* odometer: the last axis varies fastest */
+        for (int a = n_axes - 1; a >= 0; --a) {
+            if (size[a] <= 1) continue;
+            if (++idx[a] < size[a]) break;
+            idx[a] = 0;
+        }
+    }
+    return MPM_OK;
+}
+
+void matrix_cells_free(MatrixCells *c)
+{
+    for (int i = 0; i < c->n; ++i) cell_release(&c->cells[i]);
+    free(c->cells);
+    memset(c, 0, sizeof *c);
+}
+
+void matrix_cells_keep(MatrixCells *c, const int *keep)
+{
+    int k = 0;
+    for (int i = 0; i < c->n; ++i) {
+        if (keep[i]) c->cells[k++] = c->cells[i];
+        else cell_release(&c->cells[i]);
+    }
+    c->n = k;
+}
+
+void matrix_cell_name(const MatrixCell *c, char *out, size_t n) { snprintf(out, n, "%s/%s", c->scene, c->solver); }
+
+void matrix_cell_describe(const Matrix *m, const MatrixCell *c, char *out, size_t n)
+{
+    char eps[32], scale[32];
+    matrix_format_number(c->eps, eps, sizeof eps);
+    matrix_format_number(c->scale, scale, sizeof scale);
+    size_t len = (size_t)snprintf(out, n, "eps=%s scale=%s", eps, scale);
+    if (c->threads && len < n) len += (size_t)snprintf(out + len, n - len, " threads=%d", c->threads);
+    if (c->frames && len < n) len += (size_t)snprintf(out + len, n - len, " frames=%d", c->frames);
+    if (c->first_timed_frame && len < n) len += (size_t)snprintf(out + len, n - len, " timed-from=%d", c->first_timed_frame);
+    for (int a = 0; a < m->n_named && len < n; ++a)
+        len += (size_t)snprintf(out + len, n - len, " %s=%s", m->named[a].name, m->named[a].values[c->value[a]].label);
+}
+
+/* Appends one NUL-terminated argument. */
+static int push_arg(char *buf, size_t cap, size_t *used, int *argc, const char *fmt, const char *a, const char *b)
+{
+    int w = snprintf(buf + *used, cap - *used, fmt, a, b);
+    if (w < 0 || (size_t)w + 1 > cap - *used) return mpm_error(MPM_EINPUT, "cell command line too long");
+    *used += (size_t)w + 1;
+    (*argc)++;
+    return MPM_OK;
+}
+
+int matrix_cell_argv(const Matrix *m, const MatrixCell *c, const char *out_dir, char *buf, size_t cap, int *argc)
+{
+    size_t used = 0;
+    *argc = 0;
+    char path[2048], num[64], ply[1100];
+    matrix_scene_path(m, c->scene, path, sizeof path);
+    int st = push_arg(buf, cap, &used, argc, "%s%s", "run", "");
+    st |= push_arg(buf, cap, &used, argc, "%s%s", "--scene", "");
+    st |= push_arg(buf, cap, &used, argc, "%s%s", path, "");
+    st |= push_arg(buf, cap, &used, argc, "%s%s", "--solver", "");
+    st |= push_arg(buf, cap, &used, argc, "%s%s", c->solver, "");
+    matrix_format_number(c->eps, num, sizeof num); /* reads back as the same double */
+    st |= push_arg(buf, cap, &used, argc, "%s%s", "--eps", "");
+    st |= push_arg(buf, cap, &used, argc, "%s%s", num, "");
+    matrix_format_number(c->scale, num, sizeof num);
+    st |= push_arg(buf, cap, &used, argc, "%s%s", "--scale", "");
+    st |= push_arg(buf, cap, &used, argc, "%s%s", num, "");
+    if (c->threads) {
+        snprintf(num, sizeof num, "%d", c->threads);
+        st |= push_arg(buf, cap, &used, argc, "%s%s", "--threads", "");
+        st |= push_arg(buf, cap, &used, argc, "%s%s", num, "");
+    }
+    if (c->frames) {
+        snprintf(num, sizeof num, "%d", c->frames);
+        st |= push_arg(buf, cap, &used, argc, "%s%s", "--frames", "");
+        st |= push_arg(buf, cap, &used, argc, "%s%s", num, "");
+    }
+    for (int i = 0; i < c->n_set; ++i) {
+        st |= push_arg(buf, cap, &used, argc, "%s%s", "--set", "");
+        st |= push_arg(buf, cap, &used, argc, "%s=%s", c->set[i].key, c->set[i].value);
+    }
+    for (int i = 0; i < c->n_solver_opts; ++i) {
+        st |= push_arg(buf, cap, &used, argc, "%s%s", "--solver-opt", "");
+        st |= push_arg(buf, cap, &used, argc, "%s=%s", c->solver_opts[i].key, c->solver_opts[i].value);
+    }
+    if (c->history) st |= push_arg(buf, cap, &used, argc, "%s%s", "--history", "");
+    if (c->armijo) st |= push_arg(buf, cap, &used, argc, "%s%s", "--armijo", "");
+    if (c->particles) {
+        snprintf(ply, sizeof ply, "%s/particles", out_dir);
+        st |= push_arg(buf, cap, &used, argc, "%s%s", "--particles", "");
+        st |= push_arg(buf, cap, &used, argc, "%s%s", ply, "");
+    }
+    if (c->asset_dir[0]) {
+        st |= push_arg(buf, cap, &used, argc, "%s%s", "--asset-dir", "");
+        st |= push_arg(buf, cap, &used, argc, "%s%s", c->asset_dir, "");
+    }
+    st |= push_arg(buf, cap, &used, argc, "%s%s", "--quiet", "");
+    st |= push_arg(buf, cap, &used, argc, "%s%s", "--out", "");
+    st |= push_arg(buf, cap, &used, argc, "%s%s", out_dir, "");
+    return st ? MPM_EINPUT : MPM_OK;
+}
+
+int matrix_check_solver(const char *solver, const MatrixKv *opts, int n_opts)
+{
+    const SolverPreset *p = registry_find(solver);
+    if (!p) return mpm_error(MPM_EINPUT, "unknown solver '%s' (see: mpmbench list solvers)", solver);
+    char text[MATRIX_MAX_KV][200];
+    const char *user[MATRIX_MAX_KV];
+    for (int i = 0; i < n_opts; ++i) {
+        snprintf(text[i], sizeof text[i], "%s=%s", opts[i].key, opts[i].value);
+        user[i] = text[i];
+    }
+    SolverOptions so;
+    int st = registry_options(p, user, n_opts, &so);
+    Solver *s = NULL;
+    if (!st) st = solver_create(p, &so, &s);
+    if (!st) solver_destroy(s);
+    return st;
+}
+
+static void kv_text(const MatrixKv *kv, int n, int with_origin, char *out, size_t cap)
+{
+    size_t len = 0;
+    out[0] = '\0';
+    for (int i = 0; i < n && len < cap; ++i)
+        len += (size_t)snprintf(out + len, cap - len, with_origin ? "%s%s=%s (%s)" : "%s%s=%s", i ? ", " : "", kv[i].key,
+                                kv[i].value, kv[i].origin);
+}
+
+/* Checked keys, kept to check each distinct combination once. */
+typedef struct {
+    char **keys;
+    int n, cap;
+} Seen;
+
+static int seen_add(Seen *s, const char *key)
+{
+    for (int i = 0; i < s->n; ++i)
+        if (!strcmp(s->keys[i], key)) return 0;
+    if (s->n == s->cap) {
+        int cap = s->cap ? 2 * s->cap : 32;
+        char **k = realloc(s->keys, sizeof *k * (size_t)cap);
+        if (!k) return -1;
+        s->keys = k;
+        s->cap = cap;
+    }
+    if (!(s->keys[s->n] = strdup(key))) return -1;
+    s->n++;
+    return 1;
+}
+
+static void seen_free(Seen *s)
+{
+    for (int i = 0; i < s->n; ++i) free(s->keys[i]);
+    free(s->keys);
+}
+
+static int check_scene(const Matrix *m, const MatrixCell *c)
+{
+    SceneOverride ov[MATRIX_MAX_KV];
+    for (int i = 0; i < c->n_set; ++i) {
+        ov[i].key = c->set[i].key;
+        ov[i].value = c->set[i].value;
+        if (strlen(c->set[i].key) + strlen(c->set[i].value) + 2 > 256)
+            return mpm_error(MPM_EINPUT, "%s: %s: set %s=%s: longer than --set takes (255 characters)", m->base,
+                             c->set[i].origin, c->set[i].key, c->set[i].value);
+    }
+    char path[2048];
+    matrix_scene_path(m, c->scene, path, sizeof path);
+    SceneLoadOptions lo = {c->scale, ov, c->n_set, c->asset_dir[0] ? c->asset_dir : NULL};
+    Scene sc;
+    int st = scene_load(path, &lo, &sc);
+    int frames = sc.frames;
+    scene_free(&sc);
+    char scale[32], prefix[2048];
+    matrix_format_number(c->scale, scale, sizeof scale);
+    if (st) {
+        char sets[1024];
+        kv_text(c->set, c->n_set, 1, sets, sizeof sets);
+        snprintf(prefix, sizeof prefix, "%s: scene \"%s\" (%s) at scale %s%s%s", m->base, c->scene, c->scene_origin,
+                 scale, c->n_set ? " with set " : "", sets);
+        return wrap_error(st, prefix);
+    }
+    if (!c->frames && c->first_timed_frame >= frames)
+        return mpm_error(MPM_EINPUT, "%s: scene \"%s\": first_timed_frame %d is not before the scene's %d frames",
+                         m->base, c->scene, c->first_timed_frame, frames);
+    return MPM_OK;
+}
+
+int matrix_validate_cells(const Matrix *m, const MatrixCells *cells, const int *load)
+{
+    Seen solvers = {0}, scenes = {0};
+    int st = MPM_OK;
+    for (int i = 0; i < cells->n && !st; ++i) {
+        const MatrixCell *c = &cells->cells[i];
+        char key[4096], opts[2048];
+        kv_text(c->solver_opts, c->n_solver_opts, 0, opts, sizeof opts);
+        snprintf(key, sizeof key, "%s|%s", c->solver, opts);
+        int fresh = seen_add(&solvers, key);
+        if (fresh < 0) st = mpm_error(MPM_EINTERNAL, "out of memory");
+        if (fresh > 0 && (st = matrix_check_solver(c->solver, c->solver_opts, c->n_solver_opts))) {
+            char with[2048], prefix[2600];
+            kv_text(c->solver_opts, c->n_solver_opts, 1, with, sizeof with);
+            snprintf(prefix, sizeof prefix, "%s: solver \"%s\" (%s)%s%s", m->base, c->solver, c->solver_origin,
+                     c->n_solver_opts ? " with solver options " : "", with);
+            st = wrap_error(st, prefix);
+        }
+        if (st || (load && !load[i])) continue;
+        char sets[2048], scale[32], first[16];
+        kv_text(c->set, c->n_set, 0, sets, sizeof sets);
+        matrix_format_number(c->scale, scale, sizeof scale);
+        snprintf(first, sizeof first, "%d", c->frames ? 0 : c->first_timed_frame);
+        snprintf(key, sizeof key, "%s|%s|%s|%s|%s", c->scene, scale, sets, c->asset_dir, first);
+        fresh = seen_add(&scenes, key);
+        if (fresh < 0) st = mpm_error(MPM_EINTERNAL, "out of memory");
+        if (fresh > 0) st = check_scene(m, c);
+    }
+    seen_free(&solvers);
+    seen_free(&scenes);
+    return st;
+}
