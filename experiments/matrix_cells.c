@@ -41,35 +41,121 @@ static int kv_merge(const Matrix *m, const char *scene, MatrixKvList *dst, const
 
 static int cmp_kv(const void *a, const void *b) { return strcmp(((const MatrixKv *)a)->key, ((const MatrixKv *)b)->key); }
 
+/* FNV-1a, 64 bits (offset basis 0xcbf29ce484222325, prime 0x100000001b3). */
 static uint64_t fnv1a64(const char *s)
 {
-    uint64_t h = 1469598103934665603ULL;
+    uint64_t h = 0xcbf29ce484222325ULL;
     for (; *s; ++s) {
         h ^= (unsigned char)*s;
-        h *= 1099511628211ULL;
+        h *= 0x100000001b3ULL;
     }
     return h;
 }
 
-static json_t *kv_object(const MatrixKv *kv, int n)
+/* Growing text buffer for the canonical form. */
+typedef struct {
+    char *s;
+    size_t len, cap;
+    int bad;
+} Text;
+
+static void text_add(Text *t, const char *s)
 {
-    json_t *o = json_object();
-    for (int i = 0; i < n; ++i) json_object_set_new(o, kv[i].key, json_string(kv[i].value));
-    return o;
+    size_t n = strlen(s);
+    if (t->bad) return;
+    if (t->len + n + 1 > t->cap) {
+        size_t cap = 2 * (t->len + n + 1) + 256;
+        char *p = realloc(t->s, cap);
+        if (!p) {
+            t->bad = 1;
+            return;
+        }
+        t->s = p;
+        t->cap = cap;
+    }
+    memcpy(t->s + t->len, s, n + 1);
+    t->len += n;
 }
 
-/* The canonical serialisation and the id derived from it. */
+/* A JSON string literal (jansson's escaping). */
+static void text_string(Text *t, const char *s)
+{
+    json_t *j = json_string(s);
+    char *q = j ? json_dumps(j, JSON_ENCODE_ANY) : NULL;
+    if (q) text_add(t, q);
+    else t->bad = 1;
+    free(q);
+    json_decref(j);
+}
+
+static void text_key(Text *t, const char *key, int first)
+{
+    if (!first) text_add(t, ",");
+    text_string(t, key);
+    text_add(t, ":");
+}
+
+static void text_number(Text *t, double v)
+{
+    char num[64];
+    matrix_format_number(v, num, sizeof num);
+    text_add(t, num);
+}
+
+static void text_int(Text *t, int v)
+{
+    char num[32];
+    snprintf(num, sizeof num, "%d", v);
+    text_add(t, num);
+}
+
+static void text_kv(Text *t, const MatrixKv *kv, int n)
+{
+    text_add(t, "{");
+    for (int i = 0; i < n; ++i) { /* sorted by key */
+        text_key(t, kv[i].key, i == 0);
+        text_string(t, kv[i].value);
+    }
+    text_add(t, "}");
+}
+
+/* The canonical serialisation (JSON, keys in alphabetical order, numbers as
+ * the shortest text that reads back the same, so no library's number
+ * formatting enters an id) and the id derived from it. */
 static int cell_identify(MatrixCell *c)
 {
-    json_t *o = json_pack("{s:s, s:s, s:f, s:f, s:i, s:i, s:i, s:b, s:b, s:b, s:o, s:o}", "scene", c->scene, "solver",
-                          c->solver, "eps", c->eps, "scale", c->scale, "threads", c->threads, "frames", c->frames,
-                          "first_timed_frame", c->first_timed_frame, "history", c->history, "armijo", c->armijo,
-                          "particles", c->particles, "set", kv_object(c->set, c->n_set), "solver_opts",
-                          kv_object(c->solver_opts, c->n_solver_opts));
-    if (!o) return mpm_error(MPM_EINTERNAL, "out of memory (cell settings)");
-    c->canonical = json_dumps(o, JSON_SORT_KEYS | JSON_COMPACT | JSON_REAL_PRECISION(17));
-    json_decref(o);
-    if (!c->canonical) return mpm_error(MPM_EINTERNAL, "out of memory (cell settings)");
+    Text t = {NULL, 0, 0, 0};
+    text_add(&t, "{");
+    text_key(&t, "armijo", 1);
+    text_add(&t, c->armijo ? "true" : "false");
+    text_key(&t, "eps", 0);
+    text_number(&t, c->eps);
+    text_key(&t, "first_timed_frame", 0);
+    text_int(&t, c->first_timed_frame);
+    text_key(&t, "frames", 0);
+    text_int(&t, c->frames);
+    text_key(&t, "history", 0);
+    text_add(&t, c->history ? "true" : "false");
+    text_key(&t, "particles", 0);
+    text_add(&t, c->particles ? "true" : "false");
+    text_key(&t, "scale", 0);
+    text_number(&t, c->scale);
+    text_key(&t, "scene", 0);
+    text_string(&t, c->scene);
+    text_key(&t, "set", 0);
+    text_kv(&t, c->set, c->n_set);
+    text_key(&t, "solver", 0);
+    text_string(&t, c->solver);
+    text_key(&t, "solver_opts", 0);
+    text_kv(&t, c->solver_opts, c->n_solver_opts);
+    text_key(&t, "threads", 0);
+    text_int(&t, c->threads);
+    text_add(&t, "}");
+    if (t.bad) {
+        free(t.s);
+        return mpm_error(MPM_EINTERNAL, "out of memory (cell settings)");
+    }
+    c->canonical = t.s;
     snprintf(c->id, sizeof c->id, "%012llx", (unsigned long long)(fnv1a64(c->canonical) & 0xffffffffffffULL));
     return MPM_OK;
 }

@@ -171,25 +171,32 @@ static char *read_file(const char *path, size_t *n)
 static int cmp_str(const void *a, const void *b) { return strcmp(*(const char *const *)a, *(const char *const *)b); }
 
 /* The old rows under the new header, by column name. */
-static int remap(const char *dir, const char *path, const CsvTable *old, const char *header)
+static int remap(const char *dir, const char *path, const CsvTable *old, const char *header, CellsFillFn fill,
+                 void *fill_ctx)
 {
     CsvTable h;
     int st = csv_parse(header, strlen(header), &h);
     if (st) return st;
     size_t cap = strlen(header) + 2, len = 0;
-    for (int r = 0; r < old->n_rows; ++r)
-        for (int c = 0; c < old->n_cols; ++c) cap += 2 * strlen(old->rows[r][c]) + 4 + (size_t)h.n_cols;
+    for (int r = 0; r < old->n_rows; ++r) {
+        cap += (size_t)h.n_cols * (2 * 256 + 1) + 4; /* filled values: at most 255 characters, quoted */
+        for (int c = 0; c < old->n_cols; ++c) cap += 2 * strlen(old->rows[r][c]) + 4;
+    }
     char *buf = malloc(cap);
     if (!buf) {
         csv_free(&h);
         return mpm_error(MPM_EINTERNAL, "out of memory");
     }
     len = (size_t)snprintf(buf, cap, "%s\n", header);
+    int c_id = csv_col(old, "id");
     for (int r = 0; r < old->n_rows; ++r) {
         for (int c = 0; c < h.n_cols; ++c) {
             if (c) buf[len++] = ',';
             buf[len] = '\0';
-            csv_put(buf, cap, &len, csv_get(old, r, csv_col(old, h.header[c])));
+            int oc = csv_col(old, h.header[c]);
+            char filled[256] = "";
+            if (oc < 0 && fill) fill(fill_ctx, csv_get(old, r, c_id), h.header[c], filled, sizeof filled);
+            csv_put(buf, cap, &len, oc >= 0 ? csv_get(old, r, oc) : filled);
         }
         buf[len++] = '\n';
     }
@@ -210,25 +217,26 @@ static int index_ids(CellsFile *f)
     return MPM_OK;
 }
 
-int cells_file_open(const char *dir, const char *header, int writable, CellsFile *f)
+int cells_file_open(const char *dir, const char *header, int writable, CellsFillFn fill, void *fill_ctx,
+                    CellsFile *f)
 {
     memset(f, 0, sizeof *f);
     f->fd = -1;
     snprintf(f->path, sizeof f->path, "%s/cells.csv", dir);
     size_t n = 0;
     char *data = read_file(f->path, &n);
-    if (!writable) {
-        int st = data ? csv_parse(data, n, &f->rows) : MPM_OK;
-        free(data);
-        if (st) return st;
-        return index_ids(f);
-    }
     size_t keep = 0; /* bytes of whole lines */
     for (size_t i = n; i > 0; --i)
         if (data[i - 1] == '\n') {
             keep = i;
             break;
         }
+    if (!writable) { /* what a writable open would keep, without changing the file */
+        int st = keep ? csv_parse(data, keep, &f->rows) : MPM_OK;
+        free(data);
+        if (st) return st;
+        return index_ids(f);
+    }
     int st = MPM_OK;
     size_t header_len = strlen(header);
     if (keep == 0) { /* new, or not even a whole header line */
@@ -249,7 +257,7 @@ int cells_file_open(const char *dir, const char *header, int writable, CellsFile
         size_t first_len = (size_t)(nl - data);
         if (first_len && data[first_len - 1] == '\r') first_len--;
         if (!st && (first_len != header_len || memcmp(data, header, header_len) != 0))
-            st = remap(dir, f->path, &f->rows, header);
+            st = remap(dir, f->path, &f->rows, header, fill, fill_ctx);
     }
     free(data);
     if (!st) st = index_ids(f);

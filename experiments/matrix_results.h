@@ -30,12 +30,19 @@ int matrix_results_header(const Matrix *m, char *out, size_t cap);
 int matrix_results_row(const Matrix *m, const MatrixCell *c, const CellOutcome *o, const CellMeasure *x, char *out,
                        size_t cap);
 
+/* Value of `column` for the row of cell `id` when the file's header lacks
+ * that column (an axis added to the matrix); returns 0 and leaves out
+ * empty when it has none. */
+typedef int (*CellsFillFn)(void *ctx, const char *id, const char *column, char *out, size_t cap);
+
 /* Opens DIR/cells.csv to append rows under `header`: creates it, or reads
  * the rows there (a cut-short last line is dropped); a file with another
  * header (the matrix gained an axis) is rewritten with this one, its rows
- * mapped by column name. With writable 0 (a dry run) it only reads the rows,
- * if the file exists, and changes nothing. */
-int cells_file_open(const char *dir, const char *header, int writable, CellsFile *f);
+ * mapped by column name and the new columns filled by `fill` (may be NULL).
+ * With writable 0 (a dry run) it only reads the rows, if the file exists,
+ * and changes nothing. */
+int cells_file_open(const char *dir, const char *header, int writable, CellsFillFn fill, void *fill_ctx,
+                    CellsFile *f);
 int cells_file_has(const CellsFile *f, const char *id);
 /* Expected seconds of a cell from the rows there: mean elapsed_s of the rows
  * with the same scene, solver and scale, else scene and solver, else solver;

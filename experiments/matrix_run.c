@@ -221,6 +221,19 @@ static int build_tasks(Run *r, MatrixTask **out)
     return MPM_OK;
 }
 
+/* A named-axis column new to cells.csv: the label of the cell with that id. */
+static int fill_column(void *ctx, const char *id, const char *column, char *out, size_t cap)
+{
+    const Run *r = ctx;
+    int a = matrix_named_index(&r->m, column);
+    for (int i = 0; i < r->cells.n && a >= 0; ++i)
+        if (!strcmp(r->cells.cells[i].id, id)) {
+            snprintf(out, cap, "%s", r->m.named[a].values[r->cells.cells[i].value[a]].label);
+            return 1;
+        }
+    return 0;
+}
+
 /* Everything rank 0 does before the cells run; *go = 0 for a dry run. */
 static int prepare(Run *r, const char *file, const MatrixRunOptions *o, int use_mpi, int ranks, int *go)
 {
@@ -241,11 +254,8 @@ static int prepare(Run *r, const char *file, const MatrixRunOptions *o, int use_
     else snprintf(r->dir, sizeof r->dir, "out/matrix-%s", r->m.name);
     char header[8192], cells_dir[1100];
     if ((st = matrix_results_header(&r->m, header, sizeof header))) return st;
-    if (!o->dry_run) {
-        snprintf(cells_dir, sizeof cells_dir, "%s/cells", r->dir);
-        if ((st = matrix_mkdir_p(cells_dir))) return st;
-    }
-    if ((st = cells_file_open(r->dir, header, !o->dry_run, &r->results))) return st;
+    /* what is done, without writing anything: a bad matrix leaves no trace */
+    if ((st = cells_file_open(r->dir, header, 0, NULL, NULL, &r->results))) return st;
     int *load = calloc((size_t)r->cells.n + 1, sizeof *load);
     r->todo = calloc((size_t)r->cells.n + 1, sizeof *r->todo);
     if (!load || !r->todo) {
@@ -264,6 +274,10 @@ static int prepare(Run *r, const char *file, const MatrixRunOptions *o, int use_
         list_cells(r);
         return MPM_OK;
     }
+    cells_file_close(&r->results);
+    snprintf(cells_dir, sizeof cells_dir, "%s/cells", r->dir);
+    if ((st = matrix_mkdir_p(cells_dir))) return st;
+    if ((st = cells_file_open(r->dir, header, 1, fill_column, r, &r->results))) return st;
     if (use_mpi && ranks > 1) order_by_estimate(r);
     if ((st = write_metadata(r, ranks, o->jobs))) return st;
     printf("matrix %s: %d cells, %d done already, %d to run on %d rank%s x %d job%s; results in %s/cells.csv\n",
