@@ -8,7 +8,11 @@
  *  - cell ids: the canonical serialisation is pinned (a change renames every
  *    cell of every result directory), the id is its FNV-1a hash, and neither
  *    reordering the axes, adding a value nor restating a default renames a
- *    cell; identical effective settings give one cell; rules select cells. */
+ *    cell; identical effective settings give one cell; rules select cells;
+ *  - cells.csv: a cut-short last row is dropped, a new header remaps the
+ *    rows by column name (filling new columns), ids are found, and the
+ *    expected time of a cell falls back from (scene, solver, scale) to
+ *    (scene, solver) to the solver. */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -22,6 +26,7 @@
 #include "experiments/matrix_child.h"
 #include "experiments/matrix_csv.h"
 #include "experiments/matrix_measure.h"
+#include "experiments/matrix_results.h"
 #include "tests/testutil.h"
 
 static char g_dir[256];
@@ -187,6 +192,52 @@ static void test_ids(void)
     }
 }
 
+static int fill(void *ctx, const char *id, const char *column, char *out, size_t cap)
+{
+    (void)ctx;
+    if (strcmp(column, "stiff")) return 0;
+    snprintf(out, cap, "label-of-%s", id);
+    return 1;
+}
+
+static void test_cells_file(void)
+{
+    char dir[320], path[400];
+    snprintf(dir, sizeof dir, "%s/res", g_dir);
+    CHECK(matrix_mkdir_p(dir) == MPM_OK, "mkdir");
+    snprintf(path, sizeof path, "%s/cells.csv", dir);
+    FILE *f = fopen(path, "w");
+    if (!f) return;
+    fputs("id,scene,solver,scale,elapsed_s\n"
+          "a1,bar3,hot,2,10\n"
+          "a2,bar3,hot,2,20\n"
+          "a3,bar3,hot,3,100\n"
+          "a4,drop,pn-pcg,1,7\n"
+          "a5,drop,pn-pcg,1,\"8\"\n"
+          "a6,drop,hot,1,1", f); /* the last row was cut short by a crash */
+    fclose(f);
+    CellsFile cf;
+    CHECK(cells_file_open(dir, "id,scene,solver,scale,elapsed_s", 0, NULL, NULL, &cf) == MPM_OK, "read-only open");
+    CHECK(cells_file_has(&cf, "a5") && !cells_file_has(&cf, "a6"), "a cut row does not count as done (read-only)");
+    cells_file_close(&cf);
+    CHECK(cells_file_open(dir, "id,scene,solver,stiff,scale,elapsed_s", 1, fill, NULL, &cf) == MPM_OK, "open");
+    CHECK(cells_file_has(&cf, "a1") && cells_file_has(&cf, "a5") && !cells_file_has(&cf, "a6") && !cells_file_has(&cf, "b"),
+          "ids");
+    CHECK(fabs(cells_file_estimate(&cf, "bar3", "hot", "2") - 15.0) < 1e-12, "same scene, solver, scale: mean");
+    CHECK(fabs(cells_file_estimate(&cf, "bar3", "hot", "9") - 130.0 / 3) < 1e-12, "same scene and solver");
+    CHECK(fabs(cells_file_estimate(&cf, "boxes", "pn-pcg", "1") - 7.5) < 1e-12, "same solver");
+    CHECK(cells_file_estimate(&cf, "bar3", "lbfgs-h", "2") == -1.0, "unknown");
+    CHECK(cells_file_append(&cf, "b1,bar3,hot,x,2,5") == MPM_OK, "append");
+    cells_file_close(&cf);
+    CsvTable t;
+    CHECK(csv_read(path, &t) == MPM_OK, "reread");
+    CHECK(t.n_cols == 6 && t.n_rows == 6, "%d columns, %d rows (cut row gone, one appended)", t.n_cols, t.n_rows);
+    CHECK(!strcmp(csv_get(&t, 0, csv_col(&t, "stiff")), "label-of-a1") && !strcmp(csv_get(&t, 4, csv_col(&t, "elapsed_s")), "8"),
+          "remapped by name, new column filled");
+    CHECK(!strcmp(csv_get(&t, 5, 0), "b1"), "appended row last");
+    csv_free(&t);
+}
+
 int main(void)
 {
     snprintf(g_dir, sizeof g_dir, "/tmp/test_matrix_cells.XXXXXX");
@@ -196,6 +247,7 @@ int main(void)
     test_outcome();
     test_launcher_env();
     test_ids();
+    test_cells_file();
     char cmd[320];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_dir);
     if (system(cmd) != 0) fprintf(stderr, "could not remove %s\n", g_dir);

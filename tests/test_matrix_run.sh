@@ -26,7 +26,7 @@ cat >"$tmp/m.json" <<'EOF'
 {"name": "statuses",
  "defaults": {"threads": 1, "solver": "pn-pcg"},
  "axes": {"scene": ["stretched-box", "drop", "gone.json"], "eps": [1e-7, 1e-8]},
- "scenes": {"stretched-box": {"scale": 5, "frames": 1}, "drop": {"scale": 1.5, "frames": 60},
+ "scenes": {"stretched-box": {"scale": 5, "frames": 2, "first_timed_frame": 1}, "drop": {"scale": 1.5, "frames": 60},
             "gone.json": {"scale": 5, "frames": 1}},
  "exclude": [{"scene": ["stretched-box", "gone.json"], "eps": 1e-8}],
  "cell_timeout_s": 3}
@@ -82,6 +82,10 @@ assert int(row["outer_iters"]) == sum(int(s["outer_iters"]) for s in steps) > 0
 assert int(row["linear_iters"]) == sum(int(s["linear_iters"]) for s in steps) > 0
 assert float(row["max_residual"]) == max(float(s["residual"]) for s in steps)
 assert abs(float(row["wall_s"]) - sum(float(f["wall_s"]) for f in frames)) < 1e-5
+timed = [float(f["wall_s"]) for f in frames if int(f["frame"]) >= 1]  # first_timed_frame 1
+assert int(row["frames"]) == 2 and int(row["timed_frames"]) == len(timed) == 1, row
+assert abs(float(row["timed_wall_s"]) - sum(timed)) < 1e-5 and abs(float(row["max_frame_s"]) - max(timed)) < 1e-5
+assert abs(float(row["s_per_frame"]) - sum(timed) / len(timed)) < 1e-5
 assert float(row["converged_fraction"]) == 1.0 and row["worst_solve_status"] == "converged"
 assert float(row["startup_s"]) == round(run["startup_s"], 6) >= 0
 assert float(row["peak_rss_mb"]) > 1 and float(row["elapsed_s"]) > 0
