@@ -5,7 +5,8 @@
 # validation), the matrix goes on, and cells.csv has one row per cell with
 # the numbers of the cell's own CSV files. Then resuming: done cells are
 # skipped, a row cut short by a crash is dropped, a cell without a row is
-# redone from an empty directory, an axis added to the matrix keeps the ids
+# redone from an empty directory (and a killed runner leaves no cell running),
+# an axis added to the matrix keeps the ids
 # of the cells whose settings it does not change and fills its column in
 # the old rows. The cell directory holds the child's quiet output, run.json
 # with startup_s and provenance, and cmd.txt, which reproduces the cell.
@@ -43,7 +44,7 @@ runner=$!
 # crash the second cell's child as soon as it runs, and remove the last cell's scene meanwhile
 pid=""
 for _ in $(seq 600); do
-  pid=$(pgrep -f "cells/$id_crash" | head -1)
+  pid=$(pgrep -f "^mpmbench run .*cells/$id_crash" | head -1)
   [ -n "$pid" ] && break
   sleep 0.05
 done
@@ -102,6 +103,24 @@ cmd=$(sed "s|^mpmbench |'$bin' |; s|--out [^ ]*$|--out '$tmp/again'|" "$d/cmd.tx
 bash -c "$cmd" >/dev/null 2>&1
 check "cmd.txt reruns the cell: same iterations" test "$(cut -d, -f10,11 "$tmp/again/steps.csv")" = "$(cut -d, -f10,11 "$d/steps.csv")"
 
+# a runner killed while a cell runs takes the cell's process with it
+cat >"$tmp/long.json" <<'EOF2'
+{"name": "long", "defaults": {"threads": 1, "solver": "pn-pcg", "scene": "drop", "scale": 1.5, "frames": 60}}
+EOF2
+"$bin" matrix run "$tmp/long.json" --out "$tmp/long" >/dev/null 2>&1 &
+runner=$!
+child=""
+for _ in $(seq 600); do
+  child=$(pgrep -f "^mpmbench run .*$tmp/long/cells" | head -1)
+  [ -n "$child" ] && break
+  sleep 0.05
+done
+check "long cell started" test -n "$child"
+kill -KILL "$runner"
+{ wait "$runner"; } 2>/dev/null
+sleep 0.5
+check "killed runner: its cell's process is gone" bash -c "! kill -0 $child 2>/dev/null || grep -q '^State:.*Z' /proc/$child/status"
+
 # a matrix naming a scene file that does not exist is refused, done or not
 expect_input_error 'm\.json: axes\.scene\[2\]: scene file "gone\.json" not found' matrix run "$tmp/m.json" --out "$tmp/res"
 cp "$src/experiments/scenes/stretched-box.json" "$tmp/gone.json"
@@ -134,5 +153,5 @@ check "added axis: 2 done already, 2 to run" grep -q "4 cells, 2 done already, 2
 check "added axis: its column in the header" grep -q "^id,scene,solver,eps,scale,threads,frames_asked,first_timed_frame,stiff,set," "$tmp/ax/cells.csv"
 check "added axis: old rows kept, labelled" test "$(col "$tmp/ax/cells.csv" stiff | sort | tr '\n' ' ')" = "1e+05 1e+05 2e+05 2e+05 "
 check "added axis: old ids kept" bash -c "for i in $before; do grep -q \"^\$i,\" '$tmp/ax/cells.csv' || exit 1; done"
-check "added axis: old numbers kept" test "$(col "$tmp/ax/cells.csv" outer_iters | head -2 | tr '\n' ' ')" = "$outer_before"
+check "added axis: old numbers kept" test "$(col "$tmp/ax/cells.csv" outer_iters | sed -n 1,2p | tr '\n' ' ')" = "$outer_before"
 finish
