@@ -35,8 +35,10 @@ for r in got:
     b = {k: v for k, v in ser[r["id"]].items() if k not in times}
     assert a == b, f"{r['id']}:\n{a}\n{b}"
     assert r["status"] == "ok" and r["converged_fraction"] == "1.000000", r
-amg = [r for r in got if r["solver"] == "pn-amg-pcg"]
-assert amg and all(float(r["startup_s"]) > 0 for r in amg), "BoomerAMG cells start MPI+hypre (startup_s)"
+amg = [float(r["startup_s"]) for r in got if r["solver"] == "pn-amg-pcg"]
+other = [float(r["startup_s"]) for r in got if r["solver"] != "pn-amg-pcg"]
+# MPI_Init + HYPRE_Init are charged to startup_s, not to a step: milliseconds at least, the others microseconds
+assert amg and min(amg) > 1e-3 and min(amg) > 10 * max(other), f"startup_s: AMG {amg}, others {other}"
 print("ok")
 PY
 check "cells equal the serial run's ($(tail -1 "$tmp/cmp.txt"))" grep -qx ok "$tmp/cmp.txt"
