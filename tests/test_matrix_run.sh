@@ -22,6 +22,16 @@ for r in rows:
 PY
 }
 
+cell_process() { # pattern: the pid of the cell process whose command line matches, once it runs (30 s at most)
+  local pid=""
+  for _ in $(seq 600); do
+    pid=$(pgrep -f "^mpmbench run .*$1" | head -1)
+    [ -n "$pid" ] && break
+    sleep 0.05
+  done
+  echo "$pid"
+}
+
 cp "$src/experiments/scenes/stretched-box.json" "$tmp/gone.json"
 cat >"$tmp/m.json" <<'EOF'
 {"name": "statuses",
@@ -42,12 +52,7 @@ check "four cells" test -n "$id_ok" -a -n "$id_crash" -a -n "$id_slow" -a -n "$i
 "$bin" matrix run "$tmp/m.json" --out "$tmp/res" >"$tmp/run.txt" 2>"$tmp/run.err" &
 runner=$!
 # crash the second cell's child as soon as it runs, and remove the last cell's scene meanwhile
-pid=""
-for _ in $(seq 600); do
-  pid=$(pgrep -f "^mpmbench run .*cells/$id_crash" | head -1)
-  [ -n "$pid" ] && break
-  sleep 0.05
-done
+pid=$(cell_process "cells/$id_crash")
 check "the second cell runs as a child process" test -n "$pid"
 rm -f "$tmp/gone.json"
 [ -n "$pid" ] && kill -SEGV "$pid"
@@ -109,12 +114,7 @@ cat >"$tmp/long.json" <<'EOF2'
 EOF2
 "$bin" matrix run "$tmp/long.json" --out "$tmp/long" >/dev/null 2>&1 &
 runner=$!
-child=""
-for _ in $(seq 600); do
-  child=$(pgrep -f "^mpmbench run .*$tmp/long/cells" | head -1)
-  [ -n "$child" ] && break
-  sleep 0.05
-done
+child=$(cell_process "$tmp/long/cells")
 check "long cell started" test -n "$child"
 kill -KILL "$runner"
 { wait "$runner"; } 2>/dev/null
