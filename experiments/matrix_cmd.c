@@ -15,11 +15,11 @@
 
 #define MAX_ONLY 64
 
-static int parse_jobs(const char *s, int *out)
+static int parse_count(const char *flag, const char *s, int *out)
 {
     char *end = NULL;
     long v = strtol(s, &end, 10);
-    if (!s[0] || *end || v < 1 || v > 1024) return mpm_error(MPM_EINPUT, "--jobs '%s': expected an integer 1..1024", s);
+    if (!s[0] || *end || v < 1 || v > 1024) return mpm_error(MPM_EINPUT, "%s '%s': expected an integer 1..1024", flag, s);
     *out = (int)v;
     return MPM_OK;
 }
@@ -28,7 +28,7 @@ static int cmd_run(int argc, char **argv)
 {
     if (argc < 4 || argv[3][0] == '-') return mpm_error(MPM_EINPUT, "matrix run: expected a matrix file (see: mpmbench --help)");
     static const char *only[MAX_ONLY];
-    MatrixRunOptions o = {NULL, only, 0, 0, 1, NULL};
+    MatrixRunOptions o = {NULL, only, 0, 0, 1, NULL, 0};
     for (int i = 4; i < argc; ++i) {
         const char *f = argv[i];
         int has_val = i + 1 < argc;
@@ -37,14 +37,16 @@ static int cmd_run(int argc, char **argv)
             continue;
         }
         if (!strcmp(f, "--check")) return mpm_error(MPM_EINPUT, "matrix run --check: reserved, not implemented yet");
-        if (strcmp(f, "--out") && strcmp(f, "--only") && strcmp(f, "--jobs") && strcmp(f, "--asset-dir"))
+        if (strcmp(f, "--out") && strcmp(f, "--only") && strcmp(f, "--jobs") && strcmp(f, "--asset-dir") &&
+            strcmp(f, "--threads"))
             return mpm_error(MPM_EINPUT, "matrix run: unknown option '%s' (see: mpmbench --help)", f);
         if (!has_val) return mpm_error(MPM_EINPUT, "%s: missing value", f);
         const char *v = argv[++i];
         int st = MPM_OK;
         if (!strcmp(f, "--out")) o.out_dir = v;
         else if (!strcmp(f, "--asset-dir")) o.asset_dir = v;
-        else if (!strcmp(f, "--jobs")) st = parse_jobs(v, &o.jobs);
+        else if (!strcmp(f, "--jobs")) st = parse_count(f, v, &o.jobs);
+        else if (!strcmp(f, "--threads")) st = parse_count(f, v, &o.threads);
         else if (o.n_only >= MAX_ONLY) st = mpm_error(MPM_EINPUT, "--only: more than %d patterns", MAX_ONLY);
         else only[o.n_only++] = v;
         if (st) return st;

@@ -248,6 +248,12 @@ static int prepare(Run *r, const char *file, const MatrixRunOptions *o, int use_
         else snprintf(m->defaults.asset_dir, sizeof m->defaults.asset_dir, "%s/%s", cwd, o->asset_dir);
         m->defaults.has_asset_dir = 1;
     }
+    if (o->threads > 0) {
+        if (r->m.n_threads)
+            return mpm_error(MPM_EINPUT, "--threads %d: %s has a threads axis (axes.threads)", o->threads, r->m.base);
+        r->m.defaults.threads = o->threads;
+        r->m.defaults.has_threads = 1;
+    }
     if ((st = matrix_expand(&r->m, &r->cells))) return st;
     if ((st = select_cells(r, o))) return st;
     if (o->out_dir) snprintf(r->dir, sizeof r->dir, "%s", o->out_dir);
@@ -330,7 +336,7 @@ int matrix_run(const char *file, const MatrixRunOptions *o)
         }
         if (rank == 0) {
             clear_tick(&r);
-            printf("matrix %s: %d cells ran (%d ok, %d bad-input, %d failed, %d crashed, %d timeout) in %.1f s; %s/cells.csv\n",
+            printf("matrix %s: %d cells ran (%d ok, %d bad-input, %d failed, %d crashed, %d timeout) in %.3f s; %s/cells.csv\n",
                    r.m.name, r.n_finished, r.n_status[CELL_OK], r.n_status[CELL_BAD_INPUT], r.n_status[CELL_FAILED],
                    r.n_status[CELL_CRASHED], r.n_status[CELL_TIMEOUT], matrix_now() - r.t_start, r.dir);
         }

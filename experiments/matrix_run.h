@@ -20,6 +20,7 @@ typedef struct {
     int dry_run;                      /* list the cells and what is done */
     int jobs;                         /* cells at a time per process (>= 1) */
     const char *asset_dir;            /* NULL: the matrix's */
+    int threads;                      /* > 0: replaces defaults.threads (refused with a threads axis) */
 } MatrixRunOptions;
 
 int matrix_run(const char *file, const MatrixRunOptions *o);

@@ -94,4 +94,10 @@ check "dry run writes nothing" test ! -e "$tmp/dry"
 "$bin" matrix run "$tmp/ok.json" --dry-run --out "$tmp/dry" --only 'drop/*' --only "$(grep -m1 stretched-box/hot "$tmp/dry.txt" | cut -c1-12)" >"$tmp/only.txt"
 check "--only: by scene/solver glob and by id" test "$(grep -cE '^[0-9a-f]{12}  todo' "$tmp/only.txt")" -eq 3
 expect_input_error "--only x\*: no cell of ok.json matches" matrix run "$tmp/ok.json" --dry-run --only 'x*'
+# --threads replaces the defaults' threads (a new cell then), unless the matrix has a threads axis
+"$bin" matrix run "$tmp/ok.json" --dry-run --out "$tmp/dry" --threads 3 >"$tmp/t3.txt"
+check "--threads: the cells run with it" test "$(grep -c ' threads=3 ' "$tmp/t3.txt")" -eq 6
+check "--threads: other ids" test -z "$(comm -12 <(cut -c1-12 "$tmp/dry.txt" | sort) <(cut -c1-12 "$tmp/t3.txt" | sort) | grep -E '^[0-9a-f]{12}$')"
+mk taxis '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hot"], "threads": [1, 2]}}'
+expect_input_error "--threads 3: taxis.json has a threads axis" matrix run "$tmp/taxis.json" --threads 3 --dry-run
 finish
