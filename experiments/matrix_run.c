@@ -294,6 +294,19 @@ static int prepare(Run *r, const char *file, const MatrixRunOptions *o, int use_
     return MPM_OK;
 }
 
+/* Waits for a non-blocking MPI operation with short sleeps: a rank waiting
+ * for others (while rank 0 validates, or at the end while other ranks still
+ * run cells) must not spin on a core a cell needs. */
+static void mpi_wait_sleeping(MPI_Request *req)
+{
+    int done = 0;
+    for (;;) {
+        MPI_Test(req, &done, MPI_STATUS_IGNORE);
+        if (done) return;
+        matrix_sleep_ms(5);
+    }
+}
+
 static void run_free(Run *r)
 {
     cells_file_close(&r->results);
@@ -315,7 +328,11 @@ int matrix_run(const char *file, const MatrixRunOptions *o)
     r.results.fd = -1;
     int go = 0, st = MPM_OK;
     if (rank == 0) st = prepare(&r, file, o, use_mpi, ranks, &go);
-    if (use_mpi) MPI_Bcast(&go, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (use_mpi) {
+        MPI_Request req;
+        MPI_Ibcast(&go, 1, MPI_INT, 0, MPI_COMM_WORLD, &req);
+        mpi_wait_sleeping(&req);
+    }
     MatrixTask *tasks = NULL;
     if (go && rank == 0) {
         st = build_tasks(&r, &tasks);
@@ -343,6 +360,11 @@ int matrix_run(const char *file, const MatrixRunOptions *o)
     }
     free(tasks);
     run_free(&r);
-    if (use_mpi) MPI_Finalize();
+    if (use_mpi) {
+        MPI_Request req;
+        MPI_Ibarrier(MPI_COMM_WORLD, &req);
+        mpi_wait_sleeping(&req);
+        MPI_Finalize();
+    }
     return st;
 }
