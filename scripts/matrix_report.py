@@ -14,7 +14,9 @@ table is read by column name). Writes
   DIR/figures/*.png    800 x 500 pixels each.
 
 A case is one combination of every cell column but the solver (scene, eps,
-scale, threads, frames, timed window, named axes). Per case, a table of
+scale, threads, frames, timed window, named axes). An overview gives every
+case's s/frame per solver and the speedups against the baseline (total /
+max per frame, HOT Fig. 15); then, per case, a table of
 solvers (HOT supplement Table 1): seconds per frame over the timed window,
 the total speedup against the matrix's baseline solver (its timed wall time
 over the solver's) and the largest per-frame speedup (max over the timed
@@ -410,6 +412,32 @@ def mg_table(cs, order):
     return markdown(["level"] + list(levels), out)
 
 
+def overview(md, cases, titles, order, baseline):
+    """All cases at a glance: s/frame per solver, and speedups against the baseline (HOT Fig. 15)."""
+    if len(cases) < 2:
+        return
+    md.append("## Overview\n")
+    md.append("Seconds per frame over the timed window (`-`: the cell did not end ok):\n")
+    rows = []
+    for key, cs in sorted(cases.items()):
+        by = {c.solver: c for c in cs}
+        rows.append([titles[key]] + [fmt(by[s].s_per_frame) if s in by and by[s].status == "ok" else "-" for s in order])
+    md.append(markdown(["case"] + order, rows))
+    others = [s for s in order if s != baseline]
+    if baseline and others:
+        md.append(f"\nSpeedup against {baseline}, total / max per frame:\n")
+        rows = []
+        for key, cs in sorted(cases.items()):
+            by = {c.solver: c for c in cs}
+            line = [titles[key]]
+            for s in others:
+                total, per = speedups(by[s], by.get(baseline)) if s in by else (None, None)
+                line.append(f"{fmt(total)} / {fmt(per)}")
+            rows.append(line)
+        md.append(markdown(["case"] + others, rows))
+    md.append("")
+
+
 def main(argv):
     if len(argv) != 2 or argv[1].startswith("-"):
         die("usage: mpmbench matrix report DIR")
@@ -453,6 +481,7 @@ def main(argv):
     table_rows = []
     titles = {key: case_title(key, cols, show) for key in cases}
     per_scene = scene_settings(cells, cols, show)
+    overview(md, cases, titles, order, baseline)
     md.append("## Solvers per case\n")
     for i, (key, cs) in enumerate(sorted(cases.items())):
         title = titles[key]
