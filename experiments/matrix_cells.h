@@ -56,16 +56,4 @@ void matrix_cell_describe(const Matrix *m, const MatrixCell *c, char *out, size_
  * into out_dir, NUL-separated in buf; *argc set. MPM_EINPUT if too long. */
 int matrix_cell_argv(const Matrix *m, const MatrixCell *c, const char *out_dir, char *buf, size_t cap, int *argc);
 
-/* The cell's solver with its options through the creation path `mpmbench
- * run` uses: the one function that decides whether a solver can run. */
-int matrix_check_solver(const char *solver, const MatrixKv *opts, int n_opts);
-
-/* Checks every distinct solver + options of the cells through
- * matrix_check_solver, and, of the cells flagged in `load` (NULL: all), every
- * distinct (scene, scale, overrides, asset dir) by loading the scene once
- * (cells already done need no scene); the scene's own frame count then
- * bounds first_timed_frame. One-line MPM_EINPUT naming the matrix file,
- * where the offending setting came from and the problem. */
-int matrix_validate_cells(const Matrix *m, const MatrixCells *c, const int *load);
-
 #endif

@@ -14,6 +14,7 @@
 #include "experiments/matrix_dispatch.h"
 #include "experiments/matrix_file.h"
 #include "experiments/matrix_results.h"
+#include "experiments/matrix_validate.h"
 #include "experiments/provenance.h"
 
 int matrix_under_mpi_launcher(void)
