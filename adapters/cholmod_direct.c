@@ -17,6 +17,7 @@
 
 #include <cholmod.h>
 #include <omp.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -270,3 +271,22 @@ int cholmod_direct_info(const InvApprox *self, double *factor_nnz, int *analyze_
 }
 
 const InvApproxOps inv_cholmod_ops = {"cholmod", chol_create, chol_setup, chol_apply, chol_destroy};
+
+/* ---- library start-up and version (header: "Start-up") ---- */
+
+int cholmod_library_startup(void)
+{
+    cholmod_common c;
+    if (!cholmod_l_start(&c)) return mpm_error(MPM_EINTERNAL, "cholmod: cholmod_l_start failed");
+    cholmod_l_finish(&c);
+    return MPM_OK;
+}
+
+const char *cholmod_library_version(void)
+{
+    static char text[32];
+    int v[3] = {0, 0, 0};
+    cholmod_version(v); /* the library's, not the header's */
+    snprintf(text, sizeof text, "%d.%d.%d", v[0], v[1], v[2]);
+    return text;
+}

@@ -28,4 +28,11 @@ extern const InvApproxOps inv_cholmod_ops;
  * MPM_EINTERNAL if `self` is not a "cholmod" inverse approximation. */
 int cholmod_direct_info(const InvApprox *self, double *factor_nnz, int *analyze_count);
 
+/* Start-up: starts and finishes one CHOLMOD common, binding the library (and
+ * the BLAS under it) before a run's first step; each solver still starts its
+ * own common when created. */
+int cholmod_library_startup(void);
+/* The linked CHOLMOD's version, e.g. "3.0.14". */
+const char *cholmod_library_version(void);
+
 #endif

@@ -517,3 +517,9 @@ int boomeramg_matvec(InvApprox *self, const double *x, double *y)
 }
 
 const InvApproxOps inv_boomeramg_ops = {"boomeramg", amg_create, amg_setup, amg_apply, amg_destroy};
+
+/* ---- library start-up and version (header: "Start-up") ---- */
+
+int boomeramg_library_startup(void) { return hypre_global_init(); }
+
+const char *boomeramg_library_version(void) { return HYPRE_RELEASE_VERSION; }

@@ -59,4 +59,11 @@ int boomeramg_info(const InvApprox *self, int *levels, double *op_complexity);
  * tests check it equals the Hessian that was passed in). */
 int boomeramg_matvec(InvApprox *self, const double *x, double *y);
 
+/* Start-up: MPI_Init (when the program has not initialised MPI) and
+ * HYPRE_Init, the once-per-process work otherwise done at the first setup,
+ * so that a run can do it (and time it) before its first step. Idempotent. */
+int boomeramg_library_startup(void);
+/* hypre's release version, e.g. "2.26.0". */
+const char *boomeramg_library_version(void);
+
 #endif

@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "experiments/bench.h"
+#include "experiments/matrix_cmd.h"
 #include "experiments/registry.h"
 #include "experiments/render_cmd.h"
 #include "experiments/run.h"
@@ -22,7 +23,10 @@ static void usage(FILE *f)
             "               [--particles DIR] [--asset-dir DIR] [--armijo] [--quiet]\n"
             "  mpmbench bench spmv|assemble|p2g|all --scene NAME [--scale S] [--threads T] [--set key=value ...]\n"
             "  mpmbench render --scene NAME|FILE [--frame N] [--out FILE.png] [--solver NAME] [--scale S] [--set key=value ...]\n"
-            "               [--view front|side|top|iso] [--color material|speed] [--width W] [--height H] [--asset-dir DIR] [--threads T]\n");
+            "               [--view front|side|top|iso] [--color material|speed] [--width W] [--height H] [--asset-dir DIR] [--threads T]\n"
+            "  mpmbench matrix run FILE [--out DIR] [--only GLOB ...] [--dry-run] [--jobs N] [--threads T] [--asset-dir DIR]\n"
+            "               (under mpirun -np K: the cells spread over K ranks; --check: reserved)\n"
+            "  mpmbench matrix report DIR     (DIR/report.md and PNGs from a matrix run)\n");
 }
 
 static void print_scene(const char *name, const char *desc, void *ctx)
@@ -171,6 +175,7 @@ int main(int argc, char **argv)
     else if (!strcmp(argv[1], "run")) st = cmd_run(argc, argv);
     else if (!strcmp(argv[1], "bench")) st = cmd_bench(argc, argv);
     else if (!strcmp(argv[1], "render")) st = render_command(argc, argv);
+    else if (!strcmp(argv[1], "matrix")) st = matrix_command(argc, argv);
     else st = mpm_error(MPM_EINPUT, "unknown command '%s' (see: mpmbench --help)", argv[1]);
     if (st) {
         fprintf(stderr, "mpmbench: error: %s\n", mpm_last_error());

@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-packages=(build-essential cmake pkg-config python3 libhypre-dev libsuitesparse-dev libgsl-dev
+packages=(build-essential cmake pkg-config python3 python3-matplotlib libhypre-dev libsuitesparse-dev libgsl-dev
           libopenmpi-dev openmpi-bin libjansson-dev libpng-dev libopenblas0)
 missing=()
 for p in "${packages[@]}"; do

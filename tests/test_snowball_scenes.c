@@ -4,7 +4,7 @@
  * 35k, and has the paper's MPM choices (PIC/FLIP 0.95, backward-Euler
  * positions, volumes from the grid density, CFL 0.6, sticky colliders) and
  * Stomakhin's reference snow. Running them is the smoke matrix's job
- * (scripts/smoke_matrix.sh, tests/test_scenes_run.sh). */
+ * (experiments/matrices/smoke.json, tests/test_scenes_run.sh). */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>

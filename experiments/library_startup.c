@@ -1,0 +1,29 @@
+#include "experiments/library_startup.h"
+
+#include <omp.h>
+
+#include "adapters/cholmod_direct.h"
+#include "adapters/hypre_amg.h"
+#include "core/error.h"
+
+static double g_startup_s = 0.0;
+
+int library_startup(const SolverPreset *preset)
+{
+    double t0 = omp_get_wtime();
+    int st = MPM_OK;
+    /* the first parallel region creates the thread team */
+    volatile int team = 0;
+#pragma omp parallel
+    {
+#pragma omp atomic
+        team++;
+    }
+    (void)team;
+    if (preset && preset->inv == &inv_boomeramg_ops) st = boomeramg_library_startup();
+    if (!st && preset && preset->inv == &inv_cholmod_ops) st = cholmod_library_startup();
+    g_startup_s += omp_get_wtime() - t0;
+    return st;
+}
+
+double library_startup_seconds(void) { return g_startup_s; }

@@ -1,0 +1,16 @@
+/* Library start-up before a run's first step, so that no step is charged
+ * with it: the OpenMP thread team, and for the solvers that use them MPI +
+ * hypre (MPI_Init, HYPRE_Init) and CHOLMOD. Timed as the run's startup_s
+ * (run.json, cells.csv). The one place that maps a solver to the libraries
+ * it starts (the registry floor: it knows the adapters). */
+#ifndef MPM_LIBRARY_STARTUP_H
+#define MPM_LIBRARY_STARTUP_H
+
+#include "solvers/solver.h"
+
+/* Starts what `preset` needs (call after setting the thread count); adds the
+ * seconds taken to library_startup_seconds(). */
+int library_startup(const SolverPreset *preset);
+double library_startup_seconds(void);
+
+#endif

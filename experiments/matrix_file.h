@@ -1,0 +1,169 @@
+/* Experiment matrices: one JSON file describes a study (experiments/matrices/
+ * NAME.json); `mpmbench matrix run FILE` runs every cell of it in a child
+ * process and `mpmbench matrix report DIR` turns the results into tables and
+ * plots. This file loads and validates the matrix file.
+ *
+ * ------------------------------------------------------------------------
+ * Matrix file format. Unknown keys anywhere are errors.
+ * ------------------------------------------------------------------------
+ * {
+ *   "name": "stiffness",            required: 1-63 of [A-Za-z0-9_.-]; the
+ *                                   default output is out/matrix-NAME
+ *   "description": "...",           optional
+ *   "defaults": {                   optional: a value for every `run` flag
+ *     "scene": "bar3",              built-in name or path (relative paths:
+ *                                   from the matrix file's directory)
+ *     "solver": "hot",              preset name (mpmbench list solvers)
+ *     "eps": 1e-7, "scale": 1.86,   > 0 (defaults 1e-7 and 1)
+ *     "threads": 2,                 integer >= 1 (default: OpenMP's)
+ *     "frames": 5,                  integer >= 1 (default: the scene's)
+ *     "first_timed_frame": 0,       integer >= 0, < frames: frames before it
+ *                                   are simulated but not timed (a pusher that
+ *                                   needs a few frames to reach its target)
+ *     "set": {"materials.middle.E": 1e9},   --set overrides, path: value
+ *     "solver_opts": {"levels": 5}, --solver-opt key: value
+ *     "history": false,             --history (iters.csv, convergence plots)
+ *     "armijo": false,              --armijo
+ *     "particles": false,           --particles (PLY per frame; off by default
+ *                                   so the timed window writes no particles)
+ *     "asset_dir": "DIR"            --asset-dir; relative: from the matrix
+ *                                   file's directory (`matrix run --asset-dir`
+ *                                   overrides it, relative to the working dir)
+ *   },
+ *   "axes": {                       optional: lists of values; the cells are
+ *                                   their product. An axis replaces the
+ *                                   defaults' value. No empty lists.
+ *     "scene": ["bar3", ...], "solver": [...], "eps": [...], "scale": [...],
+ *     "threads": [...],
+ *     "sets": {                     named axes of --set override sets, e.g.
+ *       "stiffness": [{"materials.middle.E": 1e5}, {"materials.middle.E": 1e7}]
+ *                                   a list (each set's label is its value when
+ *                                   it has one key, else "k=v;k=v") or an
+ *                                   object {"LABEL": {set}, ...}
+ *     },
+ *     "solver_opts": {"mg": [{"levels": 3}, {"levels": 5}]}
+ *                                   named axes of --solver-opt sets, same form
+ *   },                              Axis names: [a-z][a-z0-9_]*, unique, none
+ *                                   of the built-in column names.
+ *   "scenes": {                     optional per-scene settings (key: a value
+ *     "boxes": {"scale": 2.52, "frames": 9, "first_timed_frame": 4,
+ *               "set": {...}}       of the scene axis); precedence:
+ *   },                              defaults < scenes.NAME < axes
+ *   "include": [RULE, ...],         optional: keep only cells matching a rule
+ *   "exclude": [RULE, ...],         optional: drop cells matching a rule
+ *                                   RULE = {"scene": "bar3", "solver":
+ *                                   ["hot", "pn-pcg"], "stiffness": "1e+05"}:
+ *                                   a cell matches when, for every key (scene,
+ *                                   solver, eps, scale, threads or a named
+ *                                   axis, by label), its value is the one
+ *                                   given or one of the list
+ *   "baseline": "pn-pcg",           optional: a solver of the matrix; the
+ *                                   report's speedups are against it
+ *   "cell_timeout_s": 1800,         optional: wall-clock limit of one cell
+ *                                   (> 0; default none); a cell over it is
+ *                                   killed and gets status "timeout"
+ *   "report": {"mg_levels": false}  optional: also tabulate mg_levels.csv
+ *                                   (HOT Fig. 8 sparsity)
+ * }
+ *
+ * Values of sets and solver_opts are JSON numbers, strings, booleans (or, for
+ * sets, arrays/objects): they are passed as the text of --set / --solver-opt.
+ *
+ * Errors: MPM_EINPUT with one line naming the file, the JSON path of the
+ * field and the bad value, e.g.
+ *   "stiffness.json: axes.eps[1]: expected a positive number, got "tight"". */
+#ifndef MPM_MATRIX_FILE_H
+#define MPM_MATRIX_FILE_H
+
+#include <jansson.h>
+
+#define MATRIX_MAX_KV 32       /* entries of one merged set / solver_opts */
+#define MATRIX_MAX_AXES 16     /* named axes */
+
+/* key=value text with where it came from (a JSON path, for error messages). */
+typedef struct {
+    char key[128];
+    char value[256];
+    char origin[256];
+} MatrixKv;
+
+typedef struct {
+    MatrixKv kv[MATRIX_MAX_KV];
+    int n;
+} MatrixKvList;
+
+typedef enum { MATRIX_SET = 0, MATRIX_SOLVER_OPTS = 1 } MatrixNamedKind;
+
+typedef struct {
+    char label[256];
+    MatrixKvList kv;
+} MatrixNamedValue;
+
+typedef struct {
+    char name[64];
+    MatrixNamedKind kind;
+    MatrixNamedValue *values;
+    int n;
+} MatrixNamedAxis;
+
+/* One optional setting (has = given). */
+typedef struct {
+    int has_scene, has_solver, has_eps, has_scale, has_threads, has_frames, has_first, has_history, has_armijo,
+        has_particles, has_asset_dir;
+    char scene[1024], solver[128];
+    char scene_origin[256], solver_origin[256];
+    double eps, scale;
+    int threads, frames, first_timed_frame, history, armijo, particles;
+    char asset_dir[1024];     /* absolute when given */
+    MatrixKvList set, solver_opts;
+} MatrixSettings;
+
+typedef struct {
+    char scene[1024];         /* as in the scene axis */
+    MatrixSettings s;         /* only scale, frames, first_timed_frame, set */
+} MatrixSceneSettings;
+
+typedef struct {
+    char file[1024];          /* as given */
+    char base[256];           /* file name without directories, for messages */
+    char dir[1024];           /* directory of the file */
+    char name[64];
+    char description[1024];
+    MatrixSettings defaults;
+    /* fixed axes: NULL / 0 = not an axis (the defaults' value) */
+    char (*scenes)[1024];
+    int n_scenes;
+    char (*solvers)[128];
+    int n_solvers;
+    double *eps, *scales;
+    int n_eps, n_scales;
+    int *threads;
+    int n_threads;
+    MatrixNamedAxis named[MATRIX_MAX_AXES];
+    int n_named;
+    MatrixSceneSettings *per_scene;
+    int n_per_scene;
+    json_t *include, *exclude;    /* arrays of validated rules, or NULL */
+    char baseline[128];           /* "" = none */
+    double cell_timeout_s;        /* 0 = none */
+    int report_mg_levels;
+    json_t *root;                 /* the parsed file */
+} Matrix;
+
+/* Loads and validates the file (structure, types, names of scenes and
+ * solvers); cells are checked further by matrix_validate_cells. On failure
+ * *m is left freeable. */
+int matrix_load(const char *path, Matrix *m);
+void matrix_free(Matrix *m);
+
+/* Index of the named axis, or -1. */
+int matrix_named_index(const Matrix *m, const char *name);
+
+/* Shortest text that reads back as the same double ("1e+05", "0.5"). */
+void matrix_format_number(double v, char *out, size_t n);
+
+/* The path scene_load is given for a scene value: built-in names unchanged,
+ * relative paths prefixed by the matrix file's directory. */
+void matrix_scene_path(const Matrix *m, const char *scene, char *out, size_t n);
+
+#endif

@@ -1,0 +1,31 @@
+/* `mpmbench matrix run FILE`: loads and validates the matrix, skips the
+ * cells DIR/cells.csv already has, runs the others (matrix_dispatch.h) and
+ * appends one row per finished cell. Writes DIR/matrix.json (the matrix as
+ * run, with its named axes, for the report) and appends this invocation's
+ * provenance to DIR/provenance.json. Under mpirun (an MPI launcher's
+ * environment) it initialises MPI and spreads the cells over the ranks; rank
+ * 0 validates, prints and writes, the others only run cells.
+ *
+ * Output on stdout: one line per finished cell; on a terminal (stderr, CI
+ * unset) also a progress line. Exit status 0 when the matrix ran (whatever
+ * the cells' statuses: they are in cells.csv), 2 for a bad matrix file or
+ * flag. */
+#ifndef MPM_MATRIX_RUN_H
+#define MPM_MATRIX_RUN_H
+
+typedef struct {
+    const char *out_dir;              /* NULL: out/matrix-NAME */
+    const char *const *only;          /* globs on the cell id or "scene/solver" */
+    int n_only;
+    int dry_run;                      /* list the cells and what is done */
+    int jobs;                         /* cells at a time per process (>= 1) */
+    const char *asset_dir;            /* NULL: the matrix's */
+    int threads;                      /* > 0: replaces defaults.threads (refused with a threads axis) */
+} MatrixRunOptions;
+
+int matrix_run(const char *file, const MatrixRunOptions *o);
+
+/* Was this process started by an MPI launcher (mpirun, srun with PMI/PMIx)? */
+int matrix_under_mpi_launcher(void);
+
+#endif
