@@ -380,7 +380,7 @@ static void mg_view(const InvApprox *self, FILE *f, InvView *out)
     }
     inv_view_add(out, "levels", info->n_levels);
     inv_view_add(out, "vcycles", (double)info->vcycles);
-    inv_view_add(out, "coarse_iters", (double)info->coarse_iters);
+    inv_view_add(out, "inner_iters", (double)info->coarse_iters); /* coarsest-level PCG */
     inv_view_add(out, "coarse_capped", (double)info->coarse_capped);
     inv_view_add(out, "setup_s", info->setup_s);
 }
