@@ -297,14 +297,6 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
         double fwall = 0.0, fmaxres = 0.0;
         char freason[256] = "";
         while (sim.frame == frame) {
-            if (cfg->max_run_s > 0 && omp_get_wtime() - run_t0 >= cfg->max_run_s) {
-                /* the run's budget is gone between two steps */
-                snprintf(stop_reason, sizeof stop_reason, "time limit --max-run-seconds %g reached", cfg->max_run_s);
-                if (fstatus < SOLVE_TIMEOUT) snprintf(freason, sizeof freason, "%s", stop_reason);
-                fstatus = worse(fstatus, SOLVE_TIMEOUT);
-                sum->stopped = 1;
-                break;
-            }
             hook.frame = frame;
             hook.step = fsteps;
             hook.fraction = (frame + sim.t_in_frame / sim.frame_dt) / frames;
@@ -326,7 +318,7 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
             flinear += ss.linear_iters;
             finner += ss.inner_iters;
             fwall += si.wall_s;
-            if (ss.residual > fmaxres) fmaxres = ss.residual;
+            if (!(ss.residual <= fmaxres)) fmaxres = ss.residual; /* NaN included */
             if ((int)ss.status > fstatus) snprintf(freason, sizeof freason, "%s", ss.reason);
             fstatus = worse(fstatus, ss.status);
             if (!si.advanced) { /* a failure the policy does not (or cannot) go past */
@@ -334,14 +326,18 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
                 sum->stopped = 1;
                 break;
             }
-            if (ss.status == SOLVE_TIMEOUT && cfg->max_run_s > 0 && omp_get_wtime() - run_t0 >= cfg->max_run_s) {
+            if (cfg->max_run_s > 0 && omp_get_wtime() - run_t0 >= cfg->max_run_s) {
+                /* the run's budget is spent: this step was the last */
                 snprintf(stop_reason, sizeof stop_reason, "time limit --max-run-seconds %g reached at frame %d step %d",
                          cfg->max_run_s, frame, fsteps - 1);
+                if (sim.frame == frame && fstatus < SOLVE_TIMEOUT) { /* the frame is cut short */
+                    snprintf(freason, sizeof freason, "%s", stop_reason);
+                    fstatus = SOLVE_TIMEOUT;
+                }
                 sum->stopped = 1;
                 break;
             }
         }
-        if (fsteps == 0 && sum->stopped) break; /* nothing of this frame ran */
         fprintf(frames_csv, "%s,%s,%d,%d,%ld,%ld,%.6f,%.6e,%s,%d,%ld,", scene.name, solver->name, frame, fsteps, fouter,
                 flinear, fwall, fmaxres, solve_status_name((SolveStatus)fstatus), threads, finner);
         csv_text(frames_csv, freason);

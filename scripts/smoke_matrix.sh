@@ -41,7 +41,8 @@ while [ $# -gt 0 ]; do
   esac
 done
 [ -x "$bin" ] || die "no executable at $bin (build first: bash scripts/setup.sh)"
-if [ "$solvers" = all ]; then solvers=$("$bin" list solvers | awk '{print $1}'); fi
+# presets: the listing's first block (outer methods and inverse approximations follow a blank line)
+if [ "$solvers" = all ]; then solvers=$("$bin" list solvers | awk 'NF == 0 {exit} {print $1}'); fi
 if [ -z "$out" ]; then
   out=$(mktemp -d)
   trap 'rm -rf "$out"' EXIT
