@@ -59,7 +59,7 @@ grep -qE '"max_run_seconds": 1(\.0*1?)?e-0?9' "$tmp/run-t/run.json"
 check "run.json records the limits" test $? -eq 0
 
 # --- stagnation: an eps at double precision's floor ends as stalled ---
-"$bin" run --scene stretched-box --scale 5 --quiet --frames 1 --solver pn-pcg --eps 1e-17 --out "$tmp/stall"
+"$bin" run --scene stretched-box --scale 5 --quiet --frames 1 --solver pn-pcg --eps 1e-17 --max-outer 300 --out "$tmp/stall"
 check "eps 1e-17: stalled, not capped or looping ($(last "$tmp/stall/steps.csv" status) after $(last "$tmp/stall/steps.csv" outer_iters))" test "$(last "$tmp/stall/steps.csv" status)" = stalled
 check "eps 1e-17: within 100 outer iterations" test "$(last "$tmp/stall/steps.csv" outer_iters)" -lt 100
 
