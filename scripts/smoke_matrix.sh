@@ -19,7 +19,7 @@
 #
 # Output: one line per run on stdout, OUT/summary.csv (scene, solver, scale,
 # frames, exit code, steps, steps not converged, outer and linear iterations,
-# particles, wall seconds) and exit 1 if any run failed.
+# particles, wall seconds, inner iterations) and exit 1 if any run failed.
 set -u
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 bin="$root/build/mpmbench"
@@ -49,7 +49,7 @@ if [ -z "$out" ]; then
 fi
 mkdir -p "$out"
 summary="$out/summary.csv"
-echo "scene,solver,scale,frames,exit,steps,not_converged,outer_iters,linear_iters,particles,wall_s" >"$summary"
+echo "scene,solver,scale,frames,exit,steps,not_converged,outer_iters,linear_iters,particles,wall_s,inner_iters" >"$summary"
 
 fails=0
 runs=0
@@ -79,9 +79,14 @@ for entry in "${entries[@]}"; do
     code=$?
     wall=$(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN {printf "%.2f", b - a}')
     stats="0,0,0,0,0"
-    [ -s "$dir/steps.csv" ] && stats=$(awk -F, 'NR > 1 {n++; if ($14 != "converged") bad++; o += $10; l += $11; p = $7}
-                                        END {printf "%d,%d,%d,%d,%d", n, bad, o, l, p}' "$dir/steps.csv")
-    echo "$scene,$solver,$scale,$scene_frames,$code,$stats,$wall" >>"$summary"
+    inner=0
+    if [ -s "$dir/steps.csv" ]; then
+      stats=$(awk -F, 'NR > 1 {n++; if ($14 != "converged") bad++; o += $10; l += $11; p = $7}
+                       END {printf "%d,%d,%d,%d,%d", n, bad, o, l, p}' "$dir/steps.csv")
+      inner=$(awk -F, 'NR == 1 {for (k = 1; k <= NF; ++k) if ($k == "inner_iters") c = k} NR > 1 && c {i += $c}
+                       END {printf "%d", i}' "$dir/steps.csv")
+    fi
+    echo "$scene,$solver,$scale,$scene_frames,$code,$stats,$wall,$inner" >>"$summary"
     IFS=, read -r steps bad outer linear particles <<<"$stats"
     if [ "$code" -ne 0 ]; then
       echo "FAIL: $scene $solver (scale $scale): exit $code: $(tail -1 "$dir.log")"
@@ -90,7 +95,7 @@ for entry in "${entries[@]}"; do
       echo "FAIL: $scene $solver: $bad of $steps steps not converged"
       fails=$((fails + 1))
     else
-      echo "ok: $scene $solver ($particles particles, $steps steps, $outer outer / $linear linear iterations, ${wall} s)"
+      echo "ok: $scene $solver ($particles particles, $steps steps, $outer outer / $linear linear / $inner inner iterations, ${wall} s)"
     fi
   done
 done
