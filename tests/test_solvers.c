@@ -24,6 +24,7 @@
  *    identical residual (determinism at a fixed thread count).
  * HOT against LBFGS-H (HOT Fig. 18) is tests/test_solvers_hot.c. */
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -173,14 +174,16 @@ static void agreement(void)
     if (st) return;
     for (int k = 1; k < np; ++k) {
         const char *name = registry_preset(k - 1)->name;
+        double t0 = omp_get_wtime();
         st = solve_first_step(name, EPS, &res[k]);
+        double t1 = omp_get_wtime();
         CHECK(st == MPM_OK, "%s: solve returned %d", name, st);
         if (st) return;
         CHECK(res[k].st.status == SOLVE_CONVERGED, "%s: status %s (%s), residual %.3e", name,
               solve_status_name(res[k].st.status), res[k].st.reason, res[k].st.residual);
         CHECK(res[k].monotone, "%s: an accepted iterate raised the energy", name);
-        printf("%-14s outer %4d linear %6ld inner %6ld residual %.3e\n", name, res[k].st.outer_iters,
-               res[k].st.linear_iters, res[k].st.inner_iters, res[k].st.residual);
+        printf("%-14s outer %4d linear %6ld inner %6ld residual %.3e (%.2f s)\n", name, res[k].st.outer_iters,
+               res[k].st.linear_iters, res[k].st.inner_iters, res[k].st.residual, t1 - t0);
     }
     /* the step is a hard one: tens of Newton iterations for the Jacobi PCG preset */
     CHECK(res[1].st.outer_iters >= 10, "%s needs %d outer iterations: pick a harder step", registry_preset(0)->name,
