@@ -160,4 +160,4 @@ static void lbfgs_destroy(OuterMethod *self)
 
 const OuterMethodOps outer_lbfgs = {
     "lbfgs", "L-BFGS with the inverse approximation as initial inverse Hessian, set up once per step (SPEC 7)",
-    OUTER_DESCENT, lbfgs_create, lbfgs_solve, lbfgs_view, lbfgs_destroy};
+    OUTER_DESCENT | OUTER_TO_TOLERANCE, lbfgs_create, lbfgs_solve, lbfgs_view, lbfgs_destroy};

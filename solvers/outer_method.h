@@ -14,8 +14,9 @@
  *    phases timed in SolveStats.
  * Adding an outer method is one new file defining its OuterMethodOps and one
  * line in experiments/registry.c; tests/test_conformance.c then checks it
- * (reaches eps, honours the cap with status capped, never accepts an energy
- * increase when it claims OUTER_DESCENT).
+ * (when it claims OUTER_TO_TOLERANCE: reaches eps, honours the cap with
+ * status capped, stalls at an unreachable tolerance; when it claims
+ * OUTER_DESCENT: never accepts an energy increase).
  *
  * Statistics contract (SolveStats, README "Solvers"):
  *  - outer_iters: iterations of the outer method;
@@ -71,7 +72,9 @@ typedef struct {
 typedef void (*IterHook)(void *ctx, int iter, double elapsed_s, double residual, double energy);
 
 enum {
-    OUTER_DESCENT = 1u << 0, /* never accepts an iterate of higher energy */
+    OUTER_DESCENT = 1u << 0,      /* never accepts an iterate of higher energy */
+    OUTER_TO_TOLERANCE = 1u << 1, /* iterates until the stopping rule holds (not, e.g., a
+                                     semi-implicit method's single linearised solve) */
 };
 
 typedef struct SolveCtx SolveCtx;

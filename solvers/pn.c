@@ -125,4 +125,4 @@ static void pn_destroy(OuterMethod *self)
 
 const OuterMethodOps outer_pn = {
     "pn",      "projected Newton: projected Hessian every iteration, inexact PCG, line search (SPEC 5)",
-    OUTER_DESCENT, pn_create, pn_solve, pn_view, pn_destroy};
+    OUTER_DESCENT | OUTER_TO_TOLERANCE, pn_create, pn_solve, pn_view, pn_destroy};
