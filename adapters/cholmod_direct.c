@@ -75,6 +75,7 @@ static int chol_create(SolverOptions *opt, InvApprox **out)
      * own printing is silenced: every failure is reported via mpm_error(). */
     s->c.print = 0;
     s->base.ops = &inv_cholmod_ops;
+    s->base.caps = INV_NEEDS_MATRIX | INV_SYMMETRIC | INV_POSITIVE;
     *out = &s->base;
     return MPM_OK;
 }
@@ -207,8 +208,9 @@ static int chol_setup(InvApprox *self, const InvSetupInput *in)
         const Sl *perm = s->L->Perm;
         const Sl u = (minor < N && perm) ? perm[minor] : minor;
         drop_factor(s); /* a broken-down supernodal factor is not reused */
+        /* a Hessian that is not positive definite is a breakdown of the step */
         if (status == CHOLMOD_NOT_POSDEF || (ok && minor < N))
-            return mpm_error(MPM_EINTERNAL,
+            return mpm_error(MPM_ENUMERIC,
                              "cholmod: Hessian is not positive definite (factorisation broke down at pivot %ld of "
                              "%ld, unknown %ld = node %ld component %ld)",
                              (long)minor, (long)N, (long)u, (long)(u / 3), (long)(u % 3));
@@ -270,7 +272,20 @@ int cholmod_direct_info(const InvApprox *self, double *factor_nnz, int *analyze_
     return MPM_OK;
 }
 
-const InvApproxOps inv_cholmod_ops = {"cholmod", chol_create, chol_setup, chol_apply, chol_destroy};
+static void chol_view(const InvApprox *self, FILE *f, InvView *out)
+{
+    const CholDirect *s = (const CholDirect *)self;
+    double lnz = s->analyzed ? s->lnz : 0.0;
+    if (f) fprintf(f, "  CHOLMOD Cholesky: %d block rows, factor nonzeros %.0f, %d symbolic analyses\n", s->n, lnz,
+                   s->analyze_count);
+    inv_view_add(out, "factor_nnz", lnz);
+    inv_view_add(out, "analyses", s->analyze_count);
+}
+
+const InvApproxOps inv_cholmod_ops = {"cholmod", "CHOLMOD sparse Cholesky factor of the Hessian, exact solves",
+                                      chol_create,  chol_setup,
+                                      chol_apply,   chol_view,
+                                      chol_destroy};
 
 /* ---- library start-up and version (header: "Start-up") ---- */
 

@@ -9,10 +9,11 @@
  *    triangle, runs the symbolic analysis (fill-reducing ordering, supernodal
  *    structure) only when H's sparsity pattern or size changed since the last
  *    analysis, and refactorises numerically every time. A matrix that is not
- *    positive definite fails with MPM_EINTERNAL naming the column; the next
- *    setup then starts from a fresh analysis.
+ *    positive definite fails with MPM_ENUMERIC (a numerical breakdown of the
+ *    step) naming the column; the next setup then starts from a fresh
+ *    analysis.
  *  - apply: z = H^-1 r exactly (up to round-off).
- * No options. CHOLMOD runs with its default (supernodal, AMD/METIS ordering
+ * No options. View: factor nonzeros and analyses. CHOLMOD runs with its default (supernodal, AMD/METIS ordering
  * chosen by fill) settings; its own printing is off, failures come back
  * through mpm_error(). */
 #ifndef MPM_CHOLMOD_DIRECT_H

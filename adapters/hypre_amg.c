@@ -197,6 +197,7 @@ static int amg_create(SolverOptions *opt, InvApprox **out)
     s->rbm = (int)rbm;
     s->max_levels = (int)max_levels;
     s->base.ops = &inv_boomeramg_ops;
+    s->base.caps = INV_NEEDS_MATRIX | INV_SYMMETRIC | INV_POSITIVE;
     *out = &s->base;
     return MPM_OK;
 }
@@ -516,7 +517,21 @@ int boomeramg_matvec(InvApprox *self, const double *x, double *y)
     return hy_check(e, "matrix-vector product");
 }
 
-const InvApproxOps inv_boomeramg_ops = {"boomeramg", amg_create, amg_setup, amg_apply, amg_destroy};
+static void amg_view(const InvApprox *self, FILE *f, InvView *out)
+{
+    int levels = 0;
+    double cx = 0.0;
+    const Amg *s = (const Amg *)self;
+    if (s->amg && boomeramg_info(self, &levels, &cx) != MPM_OK) levels = 0;
+    if (f) fprintf(f, "  hypre BoomerAMG V-cycle: %d unknowns, %d levels, operator complexity %.3f\n", 3 * s->n, levels, cx);
+    inv_view_add(out, "levels", levels);
+    inv_view_add(out, "operator_complexity", cx);
+}
+
+const InvApproxOps inv_boomeramg_ops = {"boomeramg", "one hypre BoomerAMG V-cycle (systems AMG, symmetric smoothing)",
+                                        amg_create,  amg_setup,
+                                        amg_apply,   amg_view,
+                                        amg_destroy};
 
 /* ---- library start-up and version (header: "Start-up") ---- */
 

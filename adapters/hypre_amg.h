@@ -12,7 +12,8 @@
  * builds a new hierarchy every time (values change every Newton iteration).
  * The IJ matrix is rebuilt too: refilling an assembled one measured slower
  * (see hypre_amg.c, build_matrix). Nothing of the old setup is kept.
- * Systems AMG: 3 functions per node, nodal coarsening.
+ * Systems AMG: 3 functions per node, nodal coarsening. View: levels and
+ * operator complexity of the last hierarchy.
  *
  * Options (--solver-opt key=value):
  *   amg_strong_threshold  strength threshold, in (0, 1); default 0.5 (hypre's

@@ -7,7 +7,7 @@
 #ifndef MPM_ERROR_H
 #define MPM_ERROR_H
 
-enum { MPM_OK = 0, MPM_EINTERNAL = 1, MPM_EINPUT = 2 };
+enum { MPM_OK = 0, MPM_EINTERNAL = 1, MPM_EINPUT = 2, MPM_ENUMERIC = 3 };
 
 /* Records a printf-style message and returns `status`, so callers write
  * `return mpm_error(MPM_EINPUT, "%s: field 'E' must be > 0, got %g", file, E);` */

@@ -8,20 +8,17 @@
 
 static double g_startup_s = 0.0;
 
-int library_startup(const SolverPreset *preset)
+int library_startup(const Solver *solver)
 {
     double t0 = omp_get_wtime();
     int st = MPM_OK;
     /* the first parallel region creates the thread team */
-    volatile int team = 0;
 #pragma omp parallel
     {
-#pragma omp atomic
-        team++;
     }
-    (void)team;
-    if (preset && preset->inv == &inv_boomeramg_ops) st = boomeramg_library_startup();
-    if (!st && preset && preset->inv == &inv_cholmod_ops) st = cholmod_library_startup();
+    const InvApproxOps *inv = solver && solver->inv ? solver->inv->ops : NULL;
+    if (inv == &inv_boomeramg_ops) st = boomeramg_library_startup();
+    if (!st && inv == &inv_cholmod_ops) st = cholmod_library_startup();
     g_startup_s += omp_get_wtime() - t0;
     return st;
 }

@@ -8,9 +8,9 @@
 
 #include "solvers/solver.h"
 
-/* Starts what `preset` needs (call after setting the thread count); adds the
+/* Starts what `solver` needs (call after setting the thread count); adds the
  * seconds taken to library_startup_seconds(). */
-int library_startup(const SolverPreset *preset);
+int library_startup(const Solver *solver);
 double library_startup_seconds(void);
 
 #endif

@@ -18,9 +18,11 @@ static void usage(FILE *f)
     fprintf(f,
             "usage:\n"
             "  mpmbench list solvers|scenes\n"
-            "  mpmbench run --scene NAME|FILE --solver NAME [--frames N] [--eps E] [--scale S] [--threads T]\n"
-            "               [--out DIR] [--set key=value ...] [--solver-opt key=value ...] [--history]\n"
-            "               [--particles DIR] [--asset-dir DIR] [--armijo] [--quiet]\n"
+            "  mpmbench run --scene NAME|FILE --solver NAME|OUTER:INVERSE[:key=value,...] [--frames N] [--eps E]\n"
+            "               [--scale S] [--threads T] [--out DIR] [--set key=value ...] [--solver-opt key=value ...]\n"
+            "               [--history] [--particles DIR] [--asset-dir DIR] [--armijo] [--quiet]\n"
+            "               [--max-outer N] [--max-linear N] [--max-step-seconds S] [--max-run-seconds S]\n"
+            "               [--on-failure stop|continue]\n"
             "  mpmbench bench spmv|assemble|p2g|all --scene NAME [--scale S] [--threads T] [--set key=value ...]\n"
             "  mpmbench render --scene NAME|FILE [--frame N] [--out FILE.png] [--solver NAME] [--scale S] [--set key=value ...]\n"
             "               [--view front|side|top|iso] [--color material|speed] [--width W] [--height H] [--asset-dir DIR] [--threads T]\n"
@@ -94,6 +96,22 @@ static int parse_args(int argc, char **argv, int first, Args *a)
             if ((st = parse_int(f, val, &c->frames))) return st;
             if (c->frames < 1) return mpm_error(MPM_EINPUT, "--frames %d: expected >= 1", c->frames);
         } else if (!strcmp(f, "--eps")) { NEED_VAL(); if ((st = parse_double(f, val, &c->eps))) return st; }
+        else if (!strcmp(f, "--max-outer") || !strcmp(f, "--max-linear")) {
+            NEED_VAL();
+            int *dst = !strcmp(f, "--max-outer") ? &c->max_outer : &c->max_linear;
+            if ((st = parse_int(f, val, dst))) return st;
+            if (*dst < 1) return mpm_error(MPM_EINPUT, "%s %s: expected an integer >= 1", f, val);
+        } else if (!strcmp(f, "--max-step-seconds") || !strcmp(f, "--max-run-seconds")) {
+            NEED_VAL();
+            double *dst = !strcmp(f, "--max-step-seconds") ? &c->max_step_s : &c->max_run_s;
+            if ((st = parse_double(f, val, dst))) return st;
+            if (!(*dst > 0.0) || *dst > 1e9) return mpm_error(MPM_EINPUT, "%s %s: expected seconds in (0, 1e9]", f, val);
+        } else if (!strcmp(f, "--on-failure")) {
+            NEED_VAL();
+            if (!strcmp(val, "stop")) c->on_failure = RUN_STOP;
+            else if (!strcmp(val, "continue")) c->on_failure = RUN_CONTINUE;
+            else return mpm_error(MPM_EINPUT, "--on-failure '%s': expected stop or continue", val);
+        }
         else if (!strcmp(f, "--scale")) { NEED_VAL(); if ((st = parse_double(f, val, &c->scale))) return st; }
         else if (!strcmp(f, "--threads")) {
             NEED_VAL();
@@ -126,10 +144,7 @@ static int cmd_list(int argc, char **argv)
 {
     if (argc < 3) return mpm_error(MPM_EINPUT, "list: expected 'solvers' or 'scenes'");
     if (!strcmp(argv[2], "solvers")) {
-        for (int i = 0; i < registry_count(); ++i) {
-            const SolverPreset *p = registry_get(i);
-            printf("%-16s %s\n", p->name, p->description);
-        }
+        registry_print(stdout);
         return MPM_OK;
     }
     if (!strcmp(argv[2], "scenes")) return scene_list(print_scene, NULL);
@@ -142,8 +157,6 @@ static int cmd_run(int argc, char **argv)
     run_config_default(&a.run);
     int st = parse_args(argc, argv, 2, &a);
     if (st) return st;
-    if (!a.run.scene) return mpm_error(MPM_EINPUT, "run: --scene is required");
-    if (!a.run.solver) return mpm_error(MPM_EINPUT, "run: --solver is required");
     RunSummary sum;
     st = run_simulation(&a.run, &sum);
     if (st) return st;

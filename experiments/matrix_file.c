@@ -137,8 +137,12 @@ static int get_solver(const Matrix *m, json_t *v, const char *path, char *out, s
 {
     int st = get_string(m, v, path, out, n);
     if (st) return st;
-    if (!registry_find(out))
-        return mpm_error(MPM_EINPUT, "%s: %s: unknown solver \"%s\" (see: mpmbench list solvers)", m->base, path, out);
+    if (solver_spec_check(out, NULL, 0) != MPM_OK) {
+        char msg[1024];
+        snprintf(msg, sizeof msg, "%s", mpm_last_error());
+        mpm_clear_error();
+        return mpm_error(MPM_EINPUT, "%s: %s: %s", m->base, path, msg);
+    }
     return MPM_OK;
 }
 

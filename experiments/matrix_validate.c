@@ -21,20 +21,14 @@ static int wrap_error(int status, const char *prefix)
 
 int matrix_check_solver(const char *solver, const MatrixKv *opts, int n_opts)
 {
-    const SolverPreset *p = registry_find(solver);
-    if (!p) return mpm_error(MPM_EINPUT, "unknown solver '%s' (see: mpmbench list solvers)", solver);
     char text[MATRIX_MAX_KV][200];
     const char *user[MATRIX_MAX_KV];
     for (int i = 0; i < n_opts; ++i) {
         snprintf(text[i], sizeof text[i], "%s=%s", opts[i].key, opts[i].value);
         user[i] = text[i];
     }
-    SolverOptions so;
-    int st = registry_options(p, user, n_opts, &so);
-    Solver *s = NULL;
-    if (!st) st = solver_create(p, &so, &s);
-    if (!st) solver_destroy(s);
-    return st;
+    /* the same check `run` makes before any work: spec, composition, options */
+    return solver_spec_check(solver, user, n_opts);
 }
 
 static void kv_text(const MatrixKv *kv, int n, int with_origin, char *out, size_t cap)

@@ -14,7 +14,7 @@ void progress_init(Progress *p, int total_frames)
     p->last_print = 0.0;
 }
 
-void progress_update(Progress *p, double fraction_done, int frame, int step, int iter, double residual)
+void progress_update(Progress *p, double fraction_done, int frame, int step, int iter, double residual, double step_s)
 {
     if (!p->enabled) return;
     double now = omp_get_wtime();
@@ -26,8 +26,8 @@ void progress_update(Progress *p, double fraction_done, int frame, int step, int
         double left = elapsed * (1.0 - fraction_done) / fraction_done;
         snprintf(eta, sizeof eta, "%dm%02ds", (int)(left / 60), (int)left % 60);
     }
-    fprintf(stderr, "\r\033[Kframe %d/%d  step %d  iter %d  residual %.2e  elapsed %.0fs  ETA %s", frame + 1,
-            p->total_frames, step, iter, residual, elapsed, eta);
+    fprintf(stderr, "\r\033[Kframe %d/%d  step %d  iter %d  residual %.2e  step %.1fs  elapsed %.0fs  ETA %s",
+            frame + 1, p->total_frames, step, iter, residual, step_s, elapsed, eta);
     fflush(stderr);
 }
 

@@ -296,10 +296,9 @@ typedef struct {
 
 static void rc_hook(void *ctx, int iter, double elapsed, double residual, double energy)
 {
-    (void)elapsed;
     (void)energy;
     RcHook *h = ctx;
-    progress_update(h->progress, h->fraction, h->frame, h->step, iter, residual);
+    progress_update(h->progress, h->fraction, h->frame, h->step, iter, residual, elapsed);
 }
 
 /* Advances sim by `frames` frames with the solver; *worst gets the worst
@@ -322,8 +321,12 @@ static int simulate(Simulation *sim, Solver *solver, int frames, int *worst)
             hook.fraction = (frame + sim->t_in_frame / sim->frame_dt) / frames;
             SolveStats ss;
             StepInfo si;
-            if ((status = run_step(sim, solver, &set, &work, rc_hook, &hook, &ss, &si))) goto done;
+            if ((status = run_step(sim, solver, &set, &work, rc_hook, &hook, 0, &ss, &si))) goto done;
             if ((int)ss.status > *worst) *worst = ss.status;
+            if (!si.advanced) {
+                status = mpm_error(MPM_EINTERNAL, "frame %d step %d failed: %s", frame, step, ss.reason);
+                goto done;
+            }
             ++step;
         }
         progress_clear(&prog);
@@ -405,30 +408,30 @@ int render_command(int argc, char **argv)
     static RenderArgs a;
     int status = parse_render_args(argc, argv, &a);
     if (status) return status;
-    const SolverPreset *preset = registry_find(a.solver);
-    if (!preset) return mpm_error(MPM_EINPUT, "unknown solver '%s' (see: mpmbench list solvers)", a.solver);
+    Solver *solver = NULL;
+    if ((status = solver_from_spec(a.solver, NULL, 0, &solver))) return status;
     if (a.threads > 0) omp_set_num_threads(a.threads);
 
     Scene scene;
     SceneLoadOptions lo = {a.scale, a.ov, a.n_ov, a.asset_dir};
-    if ((status = scene_load(a.scene, &lo, &scene))) return status;
+    if ((status = scene_load(a.scene, &lo, &scene))) {
+        solver_destroy(solver);
+        return status;
+    }
     char path[1100];
     if (a.out) snprintf(path, sizeof path, "%s", a.out);
     else snprintf(path, sizeof path, "%s.png", scene.name);
 
     if (a.frame == 0) {
         status = render_state(&a, &scene, &scene.particles, 0.0, path);
+        solver_destroy(solver);
         scene_free(&scene);
         return status;
     }
 
     Simulation sim;
     memset(&sim, 0, sizeof sim);
-    Solver *solver = NULL;
-    SolverOptions so;
     int worst = SOLVE_CONVERGED;
-    if ((status = registry_options(preset, NULL, 0, &so))) goto done;
-    if ((status = solver_create(preset, &so, &solver))) goto done;
     if ((status = sim_init(&sim, &scene))) goto done;
     if ((status = simulate(&sim, solver, a.frame, &worst))) goto done;
     if (worst != SOLVE_CONVERGED)

@@ -1,5 +1,5 @@
 /* The run loop: frames of steps (step_begin, solver, step_end), CSV rows,
- * per-frame table, progress. */
+ * per-frame table, progress, and the failure and time-limit policy. */
 #ifndef MPM_RUN_H
 #define MPM_RUN_H
 
@@ -7,9 +7,18 @@
 #include "core/step.h"
 #include "solvers/solver.h"
 
+/* What the run does when a step fails (a numerical breakdown: status failed,
+ * the reason in steps.csv). Default RUN_STOP. */
+typedef enum {
+    RUN_STOP = 0,     /* write the step's and the frame's rows, end the run (exit 0) */
+    RUN_CONTINUE = 1, /* apply the last accepted iterate and go on, unless the
+                         simulation state itself broke (step_begin or step_end
+                         failed): then stop as RUN_STOP */
+} FailurePolicy;
+
 typedef struct {
     const char *scene;          /* built-in name or JSON path */
-    const char *solver;         /* registry name */
+    const char *solver;         /* solver spec: preset name or OUTER:INVERSE[:k=v,...] */
     int frames;                 /* <= 0: the scene's */
     double eps;                 /* CN tolerance */
     double scale;               /* dx multiplier */
@@ -22,15 +31,22 @@ typedef struct {
     int history;                /* write iters.csv */
     const char *particles_dir;  /* PLY per frame when set */
     const char *asset_dir;
-    int armijo;
+    int armijo;                 /* the same as solver option linesearch=armijo */
     int quiet;                  /* no per-frame table */
+    /* bounds on the work (0 = the default: 10000 iterations, no time limit) */
+    int max_outer;              /* outer iterations per step */
+    int max_linear;             /* PCG iterations per linear solve */
+    double max_step_s;          /* a step's solve past this ends as timeout; the run goes on */
+    double max_run_s;           /* past this the running step ends as timeout and the run stops */
+    FailurePolicy on_failure;
 } RunConfig;
 
 typedef struct {
-    int frames, steps;
-    long outer_iters, linear_iters;
+    int frames, steps;          /* frames with at least one step row, step rows */
+    long outer_iters, linear_iters, inner_iters;
     double wall_s, max_residual;
     int worst_status;           /* SolveStatus */
+    int stopped;                /* the run ended early (failure policy or --max-run-seconds) */
     size_t particles;
     int threads;
 } RunSummary;
@@ -47,12 +63,24 @@ typedef struct {
     int active_nodes;
     double wall_s;              /* the whole step */
     double begin_s, end_s;      /* step_begin (P2G, BCs) and step_end (G2P, ...) */
+    int advanced;               /* step_end ran: the simulation moved to the next step */
 } StepInfo;
 
+/* A numerical breakdown (MPM_ENUMERIC from step_begin, the solve or
+ * step_end) is not an error here: ss->status is failed with the message in
+ * ss->reason, and MPM_OK is returned. A failed solve is applied (step_end
+ * with the last accepted iterate) only when apply_failed is set. Other
+ * errors are returned. */
 int run_step(Simulation *sim, Solver *solver, const SolveSettings *set, StepWork *w, IterHook hook, void *hook_ctx,
-             SolveStats *ss, StepInfo *info);
+             int apply_failed, SolveStats *ss, StepInfo *info);
 
 void run_config_default(RunConfig *c);
+/* Validates every setting of cfg without doing any work (no scene sampled,
+ * no folder made): flags, limits, paths, the solver spec with its options
+ * (solver_spec_check). MPM_EINPUT with one line naming the flag and value. */
+int run_config_check(const RunConfig *cfg);
+/* The solve settings cfg asks for. */
+void run_solve_settings(const RunConfig *cfg, SolveSettings *set);
 int run_simulation(const RunConfig *cfg, RunSummary *sum);
 
 #endif

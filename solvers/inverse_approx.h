@@ -1,46 +1,32 @@
 /* The inverse-Hessian approximation interface (DESIGN "the one idea").
  *
- * Every solver is an outer method (projected Newton, L-BFGS, Gast15) combined
- * with an InvApprox: something that is set up from the step's BC-projected
- * Hessian (or, matrix-free, from its block diagonal and operator) and then
- * applied as z ~= H^-1 r. PN uses it as a PCG preconditioner, L-BFGS as the
- * initial inverse Hessian of the two-loop recursion. Same split as PETSc's
- * PC or SUNDIALS' SUNLinearSolver.
+ * Every solver is an outer method (solvers/outer_method.h) combined with an
+ * InvApprox: something that is set up from the step's BC-projected Hessian
+ * (or, matrix-free, from its block diagonal and operator) and then applied as
+ * z ~= H^-1 r. Projected Newton uses it as a PCG preconditioner, L-BFGS as
+ * the initial inverse Hessian of the two-loop recursion. Same split as
+ * PETSc's PC or SUNDIALS' SUNLinearSolver.
  *
- * An implementation embeds `InvApprox` as its first member and provides an
- * InvApproxOps table; adding one is a new file plus a registry line. */
+ * An implementation embeds `InvApprox` as its first member, sets `caps` in
+ * create and provides an InvApproxOps table; adding one is a new file plus
+ * one line in experiments/registry.c. Nothing outside the implementation's
+ * file knows its type: its statistics come through the view op. Callers go
+ * through the inv_* wrappers below, which keep the object's state (apply
+ * before a successful setup is refused) and count inner iterations across
+ * setups. tests/test_conformance.c checks every registered implementation
+ * against this contract. */
 #ifndef MPM_INVERSE_APPROX_H
 #define MPM_INVERSE_APPROX_H
+
+#include <stdint.h>
+#include <stdio.h>
 
 #include "core/bsr.h"
 #include "core/node_order.h"
 #include "solvers/linear_op.h"
+#include "solvers/options.h"
 
 struct StepProblem;
-
-/* Free-form options (`--solver-opt key=value`), shared by all parts. Every
- * lookup records the key it asked for with the value in effect (given or
- * default), so that after a solver is created
- *  - a given key nobody asked for is reported as unknown (a typo must not
- *    run silently with the default; cf. PETSc's -options_left), and
- *  - the effective options can be written beside the results (run.json). */
-#define SOLVER_MAX_OPTS 32
-typedef struct {
-    int n;
-    char key[SOLVER_MAX_OPTS][32];
-    char value[SOLVER_MAX_OPTS][64];
-    int n_asked;                         /* distinct keys looked up */
-    char asked[SOLVER_MAX_OPTS][32];
-    char asked_value[SOLVER_MAX_OPTS][64]; /* value in effect */
-} SolverOptions;
-
-/* Looks up an option; returns the default when absent, and MPM_EINPUT through
- * *status (left untouched on success) when present but not a number. */
-double solver_opt_number(SolverOptions *o, const char *key, double def, int *status);
-const char *solver_opt_string(SolverOptions *o, const char *key, const char *def);
-/* MPM_EINPUT naming the first option no lookup asked for, and the options
- * `who` does take. */
-int solver_opts_check_used(const SolverOptions *o, const char *who);
 
 typedef struct {
     int n_nodes;
@@ -53,27 +39,84 @@ typedef struct {
     struct StepProblem *problem; /* for rediscretising methods (GMG) */
 } InvSetupInput;
 
-/* Work done by applications since the last setup (added to step statistics). */
+/* Capability flags (InvApprox.caps, set by create from the options). */
+enum {
+    INV_NEEDS_MATRIX = 1u << 0,  /* setup reads InvSetupInput.H: refused when it is NULL */
+    INV_MATRIX_FREE = 1u << 1,   /* works from diag, op and proj alone (H may be NULL) */
+    INV_NEEDS_PROBLEM = 1u << 2, /* setup reads InvSetupInput.problem (rediscretisation) */
+    INV_VARIABLE = 1u << 3,      /* apply is not a fixed linear map (an adaptive inner solve) */
+    INV_SYMMETRIC = 1u << 4,     /* apply is a symmetric map: x^T M y = y^T M x */
+    INV_POSITIVE = 1u << 5,      /* r^T M r > 0 for r != 0 in the free subspace (H SPD) */
+    INV_INNER_ITERS = 1u << 6,   /* apply iterates inside (counts InvStats.inner_iters) */
+};
+
+/* Work done since the last setup. */
 typedef struct {
-    long inner_iters;   /* PCG iterations inside (coarse solve, LBFGS-H) */
+    long inner_iters;   /* iterations inside (coarse PCG, LBFGS-H's PCG) */
     double setup_s, apply_s;
 } InvStats;
+
+/* What view returns: the hierarchy of the last setup (multigrid: nodes and
+ * blocks per row per level; written as mg_levels.csv) and named statistics
+ * (AMG levels and operator complexity, factor nonzeros, ...). */
+#define INV_VIEW_MAX_LEVELS 16
+#define INV_VIEW_MAX_STATS 16
+typedef struct {
+    int nodes;
+    int64_t blocks;
+    double blocks_per_row_avg;
+    int blocks_per_row_max;
+} InvLevelView;
+typedef struct {
+    int n_levels; /* 0: no level table */
+    InvLevelView level[INV_VIEW_MAX_LEVELS];
+    int n_stats;
+    struct {
+        char key[32];
+        double value;
+    } stat[INV_VIEW_MAX_STATS];
+} InvView;
+/* Appends a named statistic (ignored once the table is full). */
+void inv_view_add(InvView *v, const char *key, double value);
 
 typedef struct InvApprox InvApprox;
 typedef struct {
     const char *name;
+    const char *description;
+    /* Reads the options (each through solver_opt_*, so unknown ones are
+     * caught), allocates the object and sets base.ops and base.caps. Needs
+     * no step problem: creating validates the options. */
     int (*create)(SolverOptions *opt, InvApprox **out);
     int (*setup)(InvApprox *self, const InvSetupInput *in);
     int (*apply)(InvApprox *self, const double *r, double *z);
+    /* Prints a summary of the last setup to f (when not NULL) and fills out
+     * (when not NULL; zeroed by the caller). */
+    void (*view)(const InvApprox *self, FILE *f, InvView *out);
     void (*destroy)(InvApprox *self);
 } InvApproxOps;
 
 struct InvApprox {
     const InvApproxOps *ops;
+    unsigned caps;      /* INV_* */
     InvStats stats;
-    /* apply is not a fixed linear map (e.g. an adaptive inner PCG): PCG then
-     * uses the flexible-CG beta (solvers/pcg.c) */
-    int variable;
+    /* outer PCG uses the flexible-CG beta (solvers/pcg.c); usually
+     * caps & INV_VARIABLE, an option may turn it off (mg flexible=0) */
+    int flexible;
+    /* kept by the wrappers */
+    int ready;          /* the last setup succeeded */
+    long inner_banked;  /* inner iterations of setups before the current one */
 };
+
+/* The way to use an InvApprox. inv_setup marks it ready on success (not
+ * ready on failure); inv_apply refuses (MPM_EINTERNAL) when not ready. */
+int inv_create(const InvApproxOps *ops, SolverOptions *opt, InvApprox **out);
+int inv_setup(InvApprox *M, const InvSetupInput *in);
+int inv_apply(InvApprox *M, const double *r, double *z);
+void inv_view(const InvApprox *M, FILE *f, InvView *out);
+void inv_destroy(InvApprox *M);
+/* Inner iterations since creation (across setups). */
+long inv_inner_iters(const InvApprox *M);
+/* "needs the assembled matrix, variable, ..." for listings. */
+void inv_caps_describe(unsigned caps, char *buf, size_t len);
 
 #endif

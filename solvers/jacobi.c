@@ -21,7 +21,7 @@ int block_diag_invert(int n, const double *diag, double *dinv, const char *what)
     }
     if (bad < n) {
         const double *D = diag + 9 * (size_t)bad;
-        return mpm_error(MPM_EINTERNAL, "%s: singular diagonal block at node %d (det %g, trace %g)", what, bad,
+        return mpm_error(MPM_ENUMERIC, "%s: singular diagonal block at node %d (det %g, trace %g)", what, bad,
                          m3_det(D), D[0] + D[4] + D[8]);
     }
     return MPM_OK;
@@ -39,6 +39,7 @@ static int jacobi_create(int scalar, InvApprox **out)
     Jacobi *J = calloc(1, sizeof *J);
     if (!J) return mpm_error(MPM_EINTERNAL, "out of memory: jacobi");
     J->base.ops = scalar ? &inv_scalar_jacobi_ops : &inv_block_jacobi_ops;
+    J->base.caps = INV_MATRIX_FREE | INV_SYMMETRIC | INV_POSITIVE;
     J->scalar = scalar;
     *out = &J->base;
     return MPM_OK;
@@ -86,7 +87,7 @@ static int jacobi_setup(InvApprox *self, const InvSetupInput *in)
                     J->dinv[3 * (size_t)i + k] = 1.0 / d;
                 }
             }
-        if (bad < n) st = mpm_error(MPM_EINTERNAL, "scalar jacobi: zero or non-finite diagonal entry at node %d", bad);
+        if (bad < n) st = mpm_error(MPM_ENUMERIC, "scalar jacobi: zero or non-finite diagonal entry at node %d", bad);
     }
     self->stats.setup_s = omp_get_wtime() - t0;
     return st;
@@ -108,6 +109,13 @@ static int jacobi_apply(InvApprox *self, const double *r, double *z)
     return MPM_OK;
 }
 
+static void jacobi_view(const InvApprox *self, FILE *f, InvView *out)
+{
+    const Jacobi *J = (const Jacobi *)self;
+    if (f) fprintf(f, "  %s Jacobi on %d nodes\n", J->scalar ? "scalar" : "3x3 block", J->n);
+    inv_view_add(out, "nodes", J->n);
+}
+
 static void jacobi_destroy(InvApprox *self)
 {
     if (!self) return;
@@ -116,6 +124,8 @@ static void jacobi_destroy(InvApprox *self)
     free(J);
 }
 
-const InvApproxOps inv_block_jacobi_ops = {"block-jacobi", block_create, jacobi_setup, jacobi_apply, jacobi_destroy};
-const InvApproxOps inv_scalar_jacobi_ops = {"scalar-jacobi", scalar_create, jacobi_setup, jacobi_apply,
-                                            jacobi_destroy};
+const InvApproxOps inv_block_jacobi_ops = {"block-jacobi",
+                                           "inverse 3x3 diagonal blocks of the Hessian (HOT's default Jacobi)",
+                                           block_create, jacobi_setup, jacobi_apply, jacobi_view, jacobi_destroy};
+const InvApproxOps inv_scalar_jacobi_ops = {"jacobi", "inverse diagonal entries of the Hessian (scalar Jacobi)",
+                                            scalar_create, jacobi_setup, jacobi_apply, jacobi_view, jacobi_destroy};

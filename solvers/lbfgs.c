@@ -3,68 +3,102 @@
  * Hessian is built at dv^0 and the inverse approximation (a multigrid
  * V-cycle for HOT, an inexact PCG for LBFGS-H, ...) is set up on it; the
  * two-loop recursion applies it to q with no gamma scaling, the result is
- * projected, a backtracking line search takes the step, and the pair
- * (s, y = g_new - g_old) is kept only if y^T s > 0. Stops by the CN rule. */
+ * projected, the line-search strategy takes the step, and the pair
+ * (s, y = g_new - g_old) is kept only if y^T s > 0.
+ *
+ * Options: window (8): pairs kept, 1..64. */
 #include <math.h>
 #include <omp.h>
-#include <string.h>
+#include <stdlib.h>
 
 #include "core/error.h"
-#include "core/linesearch.h"
 #include "core/vec.h"
-#include "solvers/solver.h"
+#include "solvers/outer_method.h"
 
-int lbfgs_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv, SolveStats *st, IterHook hook,
-                void *hook_ctx)
+typedef struct {
+    OuterMethod base;
+    int window;
+    int cap;
+    double *g, *g_new, *q, *d, *dv_new, *diag; /* 3n each, diag 9n */
+    double *S, *Y;                            /* window x 3n (a ring buffer) */
+    double *rho, *xi;                         /* window */
+    Bsr H;
+} Lbfgs;
+
+extern const OuterMethodOps outer_lbfgs;
+
+static int lbfgs_create(SolverOptions *opt, OuterMethod **out)
 {
-    int status;
-    size_t len = 3 * (size_t)pb->n_nodes;
-    double t_start = omp_get_wtime();
+    int st = MPM_OK;
+    int window = solver_opt_int(opt, "window", 8, 1, 64, &st);
+    if (st) return st;
+    Lbfgs *s = calloc(1, sizeof *s);
+    if (!s) return mpm_error(MPM_EINTERNAL, "out of memory: L-BFGS");
+    s->base.ops = &outer_lbfgs;
+    s->base.assembled = 1;
+    s->window = window;
+    s->rho = calloc((size_t)window, sizeof(double));
+    s->xi = calloc((size_t)window, sizeof(double));
+    if (!s->rho || !s->xi) {
+        free(s->rho);
+        free(s->xi);
+        free(s);
+        return mpm_error(MPM_EINTERNAL, "out of memory: L-BFGS");
+    }
+    *out = &s->base;
+    return MPM_OK;
+}
+
+static int lbfgs_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *st)
+{
+    Lbfgs *s = (Lbfgs *)self;
+    StepProblem *pb = c->pb;
+    const size_t len = 3 * (size_t)pb->n_nodes;
+    const size_t m = (size_t)s->window;
+    double **vecs[] = {&s->g, &s->g_new, &s->q, &s->d, &s->dv_new, &s->diag, &s->S, &s->Y};
+    const size_t per[] = {3, 3, 3, 3, 3, 9, 3 * m, 3 * m};
+    int status = solve_reserve(vecs, per, 8, pb->n_nodes, &s->cap);
+    if (status) return status;
+
+    double t0 = omp_get_wtime();
     double E = problem_energy(pb, dv);
     st->ls_evals++;
     problem_gradient(pb, dv, s->g);
+    st->linesearch_s += omp_get_wtime() - t0;
     LinearOp op;
     Projection proj;
-    solver_hessian_op(s, pb, 1, &op);
-    solver_projection(pb, &proj);
-    LineSearchOptions lso = {set->armijo, set->max_halvings};
-    int m = s->window, count = 0, head = 0; /* ring buffer of the newest `count` pairs; head = next slot */
-    long inner_before = 0;
+    solve_hessian_op(c, &s->H, &op);
+    solve_projection(c, &proj);
+    int count = 0, head = 0; /* ring buffer of the newest `count` pairs; head = next slot */
     for (int it = 0;; ++it) {
-        if (solver_should_stop(pb, set, s->g, E, it, t_start, hook, hook_ctx, st)) break;
+        if (solve_should_stop(c, s->g, E, it, st)) break;
         st->outer_iters++;
         if (it == 0) {
             /* the Hessian and its inverse approximation, once per step, lagged at dv^0 */
-            double t0 = omp_get_wtime();
-            if ((status = problem_tangent(pb, 1))) return status;
-            if ((status = problem_assemble(pb, &s->H))) return status;
-            double t1 = omp_get_wtime();
-            if ((status = solver_setup_inverse(s, pb, 1, &op, &proj))) return status;
-            st->assemble_s += t1 - t0;
-            st->setup_s += omp_get_wtime() - t1;
-            inner_before = s->inv ? s->inv->stats.inner_iters : 0;
+            if ((status = solve_assemble(c, &s->H, s->diag, st))) return status;
+            if ((status = solve_setup_inverse(c, &s->H, s->diag, &op, &proj, st))) return status;
             count = head = 0;
         }
         double t2 = omp_get_wtime();
         /* two-loop recursion on q = -g */
-        double *q = s->g_new, *d = s->p;
+        double *q = s->q, *d = s->d;
         for (size_t k = 0; k < len; ++k) q[k] = -s->g[k];
-        for (int c = 0; c < count; ++c) {
-            int i = (head - 1 - c + m) % m;
+        for (int k = 0; k < count; ++k) {
+            int i = (head - 1 - k + s->window) % s->window;
             double *Si = s->S + len * (size_t)i, *Yi = s->Y + len * (size_t)i;
-            s->xi[i] = s->rho_hist[i] * vec_dot(len, Si, q);
+            s->xi[i] = s->rho[i] * vec_dot(len, Si, q);
             vec_axpy(len, -s->xi[i], Yi, q);
         }
-        if (s->inv) {
-            if ((status = s->inv->ops->apply(s->inv, q, d))) return status;
-        } else {
-            vec_copy(len, q, d);
+        status = inv_apply(c->inv, q, d);
+        if (status) {
+            st->solve_s += omp_get_wtime() - t2;
+            return status;
         }
         problem_project(pb, d);
-        for (int c = count - 1; c >= 0; --c) {
-            int i = (head - 1 - c + m) % m;
+        for (int k = count - 1; k >= 0; --k) {
+            int i = (head - 1 - k + s->window) % s->window;
             double *Si = s->S + len * (size_t)i, *Yi = s->Y + len * (size_t)i;
-            double beta = s->rho_hist[i] * vec_dot(len, Yi, d);
+            double beta = s->rho[i] * vec_dot(len, Yi, d);
             vec_axpy(len, s->xi[i] - beta, Si, d);
         }
         double gTd = vec_dot(len, s->g, d);
@@ -73,20 +107,10 @@ int lbfgs_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv
             vec_scale(len, -1.0, d);
             gTd = -vec_dot(len, s->g, s->g);
         }
-        double t3 = omp_get_wtime();
-        st->solve_s += t3 - t2;
-        LineSearchResult lr;
-        if ((status = linesearch_backtrack(pb, dv, d, E, gTd, &lso, s->dv_new, &lr))) return status;
-        st->ls_evals += lr.evals;
-        if (lr.stalled) {
-            st->linesearch_s += omp_get_wtime() - t3;
-            st->status = SOLVE_STALLED;
-            problem_gradient(pb, dv, s->g);
-            st->residual = problem_cn_residual(pb, s->g);
-            break;
-        }
-        problem_gradient(pb, s->dv_new, s->g_new);
-        st->linesearch_s += omp_get_wtime() - t3;
+        st->solve_s += omp_get_wtime() - t2;
+        LineSearchOutcome lr;
+        if ((status = solve_line_search(c, dv, s->g, d, E, gTd, s->dv_new, s->g_new, &lr, st))) return status;
+        if (lr.stalled) break;
         /* new pair s = dv_new - dv, y = g_new - g (stored in the head slot) */
         double *Sn = s->S + len * (size_t)head, *Yn = s->Y + len * (size_t)head;
         for (size_t k = 0; k < len; ++k) {
@@ -95,16 +119,45 @@ int lbfgs_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv
         }
         double ys = vec_dot(len, Yn, Sn);
         if (ys > 0.0 && isfinite(ys)) {
-            s->rho_hist[head] = 1.0 / ys;
-            head = (head + 1) % m;
-            if (count < m) ++count;
+            s->rho[head] = 1.0 / ys;
+            head = (head + 1) % s->window;
+            if (count < s->window) ++count;
         }
         vec_copy(len, s->dv_new, dv);
-        vec_copy(len, s->g_new, s->g);
+        double *t = s->g;
+        s->g = s->g_new;
+        s->g_new = t;
         E = lr.energy;
     }
-    if (s->inv) st->linear_iters += s->inv->stats.inner_iters - inner_before;
     st->hessian_blocks = s->H.nnzb;
     st->hessian_bytes = bsr_bytes(&s->H);
     return MPM_OK;
 }
+
+static void lbfgs_view(const OuterMethod *self, FILE *f)
+{
+    const Lbfgs *s = (const Lbfgs *)self;
+    fprintf(f, "  L-BFGS: window %d, initial inverse = the inverse approximation set up once per step at dv^0\n",
+            s->window);
+}
+
+static void lbfgs_destroy(OuterMethod *self)
+{
+    Lbfgs *s = (Lbfgs *)self;
+    free(s->g);
+    free(s->g_new);
+    free(s->q);
+    free(s->d);
+    free(s->dv_new);
+    free(s->diag);
+    free(s->S);
+    free(s->Y);
+    free(s->rho);
+    free(s->xi);
+    bsr_free(&s->H);
+    free(s);
+}
+
+const OuterMethodOps outer_lbfgs = {
+    "lbfgs", "L-BFGS with the inverse approximation as initial inverse Hessian, set up once per step (SPEC 7)",
+    OUTER_DESCENT | OUTER_TO_TOLERANCE, lbfgs_create, lbfgs_solve, lbfgs_view, lbfgs_destroy};

@@ -10,7 +10,7 @@
  *     x += alpha p;  r -= alpha q;  z = P(M^-1 r)
  *     beta = r^T z_new / r^T z_old;  p = z + beta p
  *
- * A preconditioner that is not a fixed linear map (M->variable: a V-cycle
+ * A preconditioner that is not a fixed linear map (M->flexible: a V-cycle
  * whose coarsest PCG stops adaptively) breaks the conjugacy plain PCG relies
  * on; with a poor coarse operator (rediscretised GMG) plain PCG then needs
  * thousands of iterations. For those, beta takes the Polak-Ribiere form
@@ -31,6 +31,7 @@
 #include "solvers/pcg.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 
 #include "core/error.h"
@@ -66,7 +67,7 @@ void pcg_work_free(PcgWork *w)
 static int precondition(InvApprox *M, const Projection *proj, size_t len, const double *r, double *z)
 {
     if (M) {
-        int st = M->ops->apply(M, r, z);
+        int st = inv_apply(M, r, z);
         if (st) return st;
     } else {
         vec_copy(len, r, z);
@@ -80,13 +81,14 @@ int pcg_solve(const LinearOp *A, InvApprox *M, const Projection *proj, const dou
 {
     res->iters = 0;
     res->capped = 0;
+    res->timed_out = 0;
     res->rho0 = res->rho = 0.0;
     const int n = A->n_nodes;
     const size_t len = 3 * (size_t)n;
     int st = pcg_work_reserve(work, n);
     if (st) return st;
     double *r = work->r, *z = work->z, *p = work->p, *q = work->q;
-    const int flexible = M && M->variable;
+    const int flexible = M && M->flexible;
 
     vec_zero(len, x);
     vec_copy(len, b, r);
@@ -94,9 +96,9 @@ int pcg_solve(const LinearOp *A, InvApprox *M, const Projection *proj, const dou
     st = precondition(M, proj, len, r, z);
     if (st) return st;
     double rz = vec_dot(len, r, z);
-    if (!isfinite(rz)) return mpm_error(MPM_EINTERNAL, "pcg: non-finite initial residual (r^T M^-1 r = %g)", rz);
+    if (!isfinite(rz)) return mpm_error(MPM_ENUMERIC, "pcg: non-finite initial residual (r^T M^-1 r = %g)", rz);
     if (rz < 0.0)
-        return mpm_error(MPM_EINTERNAL, "pcg: preconditioner is not positive definite (r^T M^-1 r = %g)", rz);
+        return mpm_error(MPM_ENUMERIC, "pcg: preconditioner is not positive definite (r^T M^-1 r = %g)", rz);
     const double rho0 = sqrt(rz);
     res->rho0 = res->rho = rho0;
     if (rz == 0.0) return MPM_OK; /* b is zero in the free subspace: x = 0 is exact */
@@ -118,6 +120,10 @@ int pcg_solve(const LinearOp *A, InvApprox *M, const Projection *proj, const dou
             res->capped = 1;
             break;
         }
+        if (opt->deadline > 0 && omp_get_wtime() >= opt->deadline) {
+            res->timed_out = 1;
+            break;
+        }
         A->apply(A->ctx, p, q);
         projection_apply(proj, q);
         double pq = vec_dot(len, p, q);
@@ -134,7 +140,7 @@ int pcg_solve(const LinearOp *A, InvApprox *M, const Projection *proj, const dou
         ++it;
         if (!isfinite(rz_new) || rz_new < 0.0) {
             res->iters = it;
-            return mpm_error(MPM_EINTERNAL, "pcg: r^T M^-1 r = %g at iteration %d (preconditioner not SPD?)", rz_new,
+            return mpm_error(MPM_ENUMERIC, "pcg: r^T M^-1 r = %g at iteration %d (preconditioner not SPD?)", rz_new,
                              it);
         }
         double beta = rz_new / rz;

@@ -5,9 +5,12 @@
  *    (the inexact-Newton forcing term of HOT §5 / reference §4);
  *  - PCG_ABSOLUTE: stop when rho < abs_tol (coarse solves, LBFGS-H: abs_tol
  *    = 1/2 sqrt(bbar^T D^-1 bbar), reference §5.3).
- * The check is at the top of each iteration; at most max_iters iterations.
+ * The check is at the top of each iteration; at most max_iters iterations,
+ * and none after `deadline` (omp_get_wtime(); 0 = none: timed_out is set).
  * Vectors r, z and the search direction are kept in the projected subspace.
- * A variable preconditioner (InvApprox.variable) gets flexible CG's beta. */
+ * A variable preconditioner (InvApprox.flexible) gets flexible CG's beta.
+ * A breakdown (r^T M^-1 r negative or not finite: the operator or the
+ * preconditioner is not SPD, or the data hold NaN) returns MPM_ENUMERIC. */
 #ifndef MPM_PCG_H
 #define MPM_PCG_H
 
@@ -20,11 +23,13 @@ typedef struct {
     double tau;      /* PCG_FORCING floor */
     double abs_tol;  /* PCG_ABSOLUTE */
     int max_iters;   /* 10000 in every reference configuration */
+    double deadline; /* omp_get_wtime() after which no iteration starts; 0 = none */
 } PcgOptions;
 
 typedef struct {
     int iters;
     int capped;      /* hit max_iters */
+    int timed_out;   /* stopped at the deadline */
     double rho0, rho;
 } PcgResult;
 

@@ -17,22 +17,26 @@ typedef struct {
     PcgWork work;
     double *z;
     int cap, n, max_iters;
+    long applies, capped; /* since the last setup */
 } InexactPcg;
 
 static int ipcg_create(SolverOptions *opt, InvApprox **out)
 {
+    int st = MPM_OK;
+    int max_iters = solver_opt_int(opt, "max_iters", 10000, 1, 1000000000, &st);
+    if (st) return st;
     InexactPcg *s = calloc(1, sizeof *s);
     if (!s) return mpm_error(MPM_EINTERNAL, "out of memory: inexact PCG");
-    int st = MPM_OK;
-    s->max_iters = (int)solver_opt_number(opt, "max_iters", 10000, &st);
-    if (!st && s->max_iters < 1) st = mpm_error(MPM_EINPUT, "--solver-opt max_iters=%d: expected >= 1", s->max_iters);
-    if (!st) st = inv_block_jacobi_ops.create(opt, &s->jacobi);
-    if (st) {
+    s->max_iters = max_iters;
+    if ((st = inv_create(&inv_block_jacobi_ops, opt, &s->jacobi))) {
         free(s);
         return st;
     }
     s->base.ops = &inv_inexact_pcg_ops;
-    s->base.variable = 1; /* an adaptive inner PCG: not a fixed linear map */
+    /* an adaptive inner PCG: not a fixed linear map, but r^T z > 0 (CG's
+     * iterate minimises the energy over a Krylov space holding it) */
+    s->base.caps = INV_MATRIX_FREE | INV_VARIABLE | INV_POSITIVE | INV_INNER_ITERS;
+    s->base.flexible = 1;
     *out = &s->base;
     return MPM_OK;
 }
@@ -44,13 +48,14 @@ static int ipcg_setup(InvApprox *self, const InvSetupInput *in)
     s->op = in->op;
     s->proj = in->proj;
     s->n = in->n_nodes;
+    s->applies = s->capped = 0;
     if (in->n_nodes > s->cap) {
         double *z = realloc(s->z, sizeof(double) * 3 * (size_t)in->n_nodes);
         if (!z) return mpm_error(MPM_EINTERNAL, "out of memory: inexact PCG");
         s->z = z;
         s->cap = in->n_nodes;
     }
-    int st = s->jacobi->ops->setup(s->jacobi, in);
+    int st = inv_setup(s->jacobi, in);
     self->stats.inner_iters = 0;
     self->stats.apply_s = 0;
     self->stats.setup_s = omp_get_wtime() - t0;
@@ -63,24 +68,42 @@ static int ipcg_apply(InvApprox *self, const double *r, double *z)
     double t0 = omp_get_wtime();
     size_t len = 3 * (size_t)s->n;
     /* tolerance from the input: 1/2 sqrt(q^T D^-1 q) */
-    int st = s->jacobi->ops->apply(s->jacobi, r, s->z);
+    int st = inv_apply(s->jacobi, r, s->z);
     if (st) return st;
     double ref = sqrt(fmax(vec_dot(len, r, s->z), 0.0));
-    PcgOptions po = {PCG_ABSOLUTE, 0.0, 0.5 * ref, s->max_iters};
+    PcgOptions po = {PCG_ABSOLUTE, 0.0, 0.5 * ref, s->max_iters, 0.0};
     PcgResult res;
     st = pcg_solve(s->op, s->jacobi, s->proj, r, z, &po, &s->work, &res);
     self->stats.inner_iters += res.iters;
     self->stats.apply_s += omp_get_wtime() - t0;
+    s->applies++;
+    s->capped += res.capped;
     return st;
+}
+
+static void ipcg_view(const InvApprox *self, FILE *f, InvView *out)
+{
+    const InexactPcg *s = (const InexactPcg *)self;
+    if (f)
+        fprintf(f, "  inexact block-Jacobi PCG (stop at 1/2 the input's norm, cap %d): %ld applications, %ld "
+                   "iterations, %ld capped\n",
+                s->max_iters, s->applies, self->stats.inner_iters, s->capped);
+    inv_view_add(out, "applications", (double)s->applies);
+    inv_view_add(out, "inner_iters", (double)self->stats.inner_iters);
+    inv_view_add(out, "capped", (double)s->capped);
 }
 
 static void ipcg_destroy(InvApprox *self)
 {
     InexactPcg *s = (InexactPcg *)self;
-    if (s->jacobi) s->jacobi->ops->destroy(s->jacobi);
+    inv_destroy(s->jacobi);
     pcg_work_free(&s->work);
     free(s->z);
     free(s);
 }
 
-const InvApproxOps inv_inexact_pcg_ops = {"inexact-pcg", ipcg_create, ipcg_setup, ipcg_apply, ipcg_destroy};
+const InvApproxOps inv_inexact_pcg_ops = {
+    "inexact-pcg", "block-Jacobi PCG from zero to 1/2 of the input's norm (HOT LBFGS-H, SPEC 7)",
+    ipcg_create,   ipcg_setup,
+    ipcg_apply,    ipcg_view,
+    ipcg_destroy};

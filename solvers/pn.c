@@ -1,53 +1,83 @@
 /* Projected Newton (SPEC 5; HOT §5, reference §4): at every iterate the
  * projected (SPD) Hessian is rebuilt, H p = -g is solved inexactly by PCG
- * with the forcing term eta = min(0.5, sqrt(max(rho0, tau))), and a
- * backtracking line search takes the step. Stops by the CN rule. */
+ * preconditioned by the inverse approximation, with the forcing term
+ * eta = min(0.5, sqrt(max(rho0, tau))), and the line-search strategy takes
+ * the step.
+ *
+ * Options: matrix_free (0): 1 applies H through the matrix-free product
+ * (SPEC 3) and sets the inverse approximation up from the diagonal blocks
+ * only (HOT PN-PCG(MF)). */
 #include <omp.h>
-#include <string.h>
+#include <stdlib.h>
 
 #include "core/error.h"
-#include "core/linesearch.h"
 #include "core/vec.h"
-#include "solvers/solver.h"
+#include "solvers/outer_method.h"
+#include "solvers/pcg.h"
 
-int pn_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv, SolveStats *st, IterHook hook,
-             void *hook_ctx)
+typedef struct {
+    OuterMethod base;
+    int cap;
+    double *g, *g_new, *p, *rhs, *dv_new, *diag; /* 3n each, diag 9n */
+    Bsr H;
+    PcgWork pcg;
+} Pn;
+
+extern const OuterMethodOps outer_pn;
+
+static int pn_create(SolverOptions *opt, OuterMethod **out)
 {
-    int status;
-    int n = pb->n_nodes;
-    size_t len = 3 * (size_t)n;
-    int assembled = !s->preset->matrix_free;
-    double t_start = omp_get_wtime();
+    int st = MPM_OK;
+    int matrix_free = solver_opt_int(opt, "matrix_free", 0, 0, 1, &st);
+    if (st) return st;
+    Pn *s = calloc(1, sizeof *s);
+    if (!s) return mpm_error(MPM_EINTERNAL, "out of memory: projected Newton");
+    s->base.ops = &outer_pn;
+    s->base.assembled = !matrix_free;
+    *out = &s->base;
+    return MPM_OK;
+}
+
+static int pn_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *st)
+{
+    Pn *s = (Pn *)self;
+    StepProblem *pb = c->pb;
+    const size_t len = 3 * (size_t)pb->n_nodes;
+    double **vecs[] = {&s->g, &s->g_new, &s->p, &s->rhs, &s->dv_new, &s->diag};
+    const size_t per[] = {3, 3, 3, 3, 3, 9};
+    int status = solve_reserve(vecs, per, 6, pb->n_nodes, &s->cap);
+    if (status) return status;
+    Bsr *H = self->assembled ? &s->H : NULL;
+
+    double t0 = omp_get_wtime();
     double E = problem_energy(pb, dv);
     st->ls_evals++;
     problem_gradient(pb, dv, s->g);
-    double tau = problem_tau(pb, set->eps);
+    st->linesearch_s += omp_get_wtime() - t0;
+    const double tau = problem_tau(pb, c->set->eps);
     LinearOp op;
     Projection proj;
-    solver_hessian_op(s, pb, assembled, &op);
-    solver_projection(pb, &proj);
-    LineSearchOptions lso = {set->armijo, set->max_halvings};
+    solve_hessian_op(c, H, &op);
+    solve_projection(c, &proj);
     for (int it = 0;; ++it) {
-        if (solver_should_stop(pb, set, s->g, E, it, t_start, hook, hook_ctx, st)) break;
+        if (solve_should_stop(c, s->g, E, it, st)) break;
         st->outer_iters++;
+        if ((status = solve_assemble(c, H, s->diag, st))) return status;
+        if ((status = solve_setup_inverse(c, H, s->diag, &op, &proj, st))) return status;
 
-        double t0 = omp_get_wtime();
-        if ((status = problem_tangent(pb, 1))) return status;
-        if (assembled && (status = problem_assemble(pb, &s->H))) return status;
-        double t1 = omp_get_wtime();
-        if ((status = solver_setup_inverse(s, pb, assembled, &op, &proj))) return status;
         double t2 = omp_get_wtime();
-        /* solve H p = -g */
-        vec_copy(len, s->g, s->g_new);
-        vec_scale(len, -1.0, s->g_new);
-        PcgOptions po = {PCG_FORCING, tau, 0.0, set->max_linear};
+        for (size_t k = 0; k < len; ++k) s->rhs[k] = -s->g[k];
+        PcgOptions po = {PCG_FORCING, tau, 0.0, c->set->max_linear, c->set->deadline};
         PcgResult pr;
-        if ((status = pcg_solve(&op, s->inv, &proj, s->g_new, s->p, &po, &s->pcg, &pr))) return status;
+        status = pcg_solve(&op, c->inv, &proj, s->rhs, s->p, &po, &s->pcg, &pr);
         st->linear_iters += pr.iters;
-        double t3 = omp_get_wtime();
-        st->assemble_s += t1 - t0;
-        st->setup_s += t2 - t1;
-        st->solve_s += t3 - t2;
+        st->solve_s += omp_get_wtime() - t2;
+        if (status) return status;
+        if (pr.timed_out) {
+            solve_end(st, SOLVE_TIMEOUT, "time limit %s reached in PCG at outer iteration %d",
+                      c->set->deadline_reason ? c->set->deadline_reason : "", it);
+            break;
+        }
 
         double gTp = vec_dot(len, s->g, s->p);
         if (!(gTp < 0.0)) {
@@ -57,23 +87,42 @@ int pn_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv, S
             vec_scale(len, -1.0, s->p);
             gTp = -vec_dot(len, s->g, s->g);
         }
-        LineSearchResult lr;
-        if ((status = linesearch_backtrack(pb, dv, s->p, E, gTp, &lso, s->dv_new, &lr))) return status;
-        st->ls_evals += lr.evals;
-        st->linesearch_s += omp_get_wtime() - t3;
-        if (lr.stalled) {
-            st->status = SOLVE_STALLED;
-            problem_gradient(pb, dv, s->g);
-            st->residual = problem_cn_residual(pb, s->g);
-            break;
-        }
+        LineSearchOutcome lr;
+        if ((status = solve_line_search(c, dv, s->g, s->p, E, gTp, s->dv_new, s->g_new, &lr, st))) return status;
+        if (lr.stalled) break;
         vec_copy(len, s->dv_new, dv);
+        double *t = s->g;
+        s->g = s->g_new;
+        s->g_new = t;
         E = lr.energy;
-        problem_gradient(pb, dv, s->g);
     }
-    if (assembled) {
-        st->hessian_blocks = s->H.nnzb;
-        st->hessian_bytes = bsr_bytes(&s->H);
+    if (H) {
+        st->hessian_blocks = H->nnzb;
+        st->hessian_bytes = bsr_bytes(H);
     }
     return MPM_OK;
 }
+
+static void pn_view(const OuterMethod *self, FILE *f)
+{
+    fprintf(f, "  projected Newton: %s Hessian, inexact PCG with the forcing term min(0.5, sqrt(max(rho0, tau)))\n",
+            self->assembled ? "assembled" : "matrix-free");
+}
+
+static void pn_destroy(OuterMethod *self)
+{
+    Pn *s = (Pn *)self;
+    free(s->g);
+    free(s->g_new);
+    free(s->p);
+    free(s->rhs);
+    free(s->dv_new);
+    free(s->diag);
+    bsr_free(&s->H);
+    pcg_work_free(&s->pcg);
+    free(s);
+}
+
+const OuterMethodOps outer_pn = {
+    "pn",      "projected Newton: projected Hessian every iteration, inexact PCG, line search (SPEC 5)",
+    OUTER_DESCENT | OUTER_TO_TOLERANCE, pn_create, pn_solve, pn_view, pn_destroy};

@@ -147,6 +147,7 @@ static int sgs_create(SolverOptions *opt, InvApprox **out)
     Sgs *S = calloc(1, sizeof *S);
     if (!S) return mpm_error(MPM_EINTERNAL, "out of memory: sgs");
     S->base.ops = &inv_sgs_ops;
+    S->base.caps = INV_NEEDS_MATRIX | INV_SYMMETRIC | INV_POSITIVE;
     *out = &S->base;
     return MPM_OK;
 }
@@ -187,6 +188,13 @@ static int sgs_apply(InvApprox *self, const double *r, double *z)
     return st;
 }
 
+static void sgs_view(const InvApprox *self, FILE *f, InvView *out)
+{
+    const Sgs *S = (const Sgs *)self;
+    if (f) fprintf(f, "  symmetric block Gauss-Seidel, one sweep, 8 colours, %d nodes\n", S->n);
+    inv_view_add(out, "nodes", S->n);
+}
+
 static void sgs_destroy(InvApprox *self)
 {
     if (!self) return;
@@ -196,4 +204,5 @@ static void sgs_destroy(InvApprox *self)
     free(S);
 }
 
-const InvApproxOps inv_sgs_ops = {"sgs", sgs_create, sgs_setup, sgs_apply, sgs_destroy};
+const InvApproxOps inv_sgs_ops = {"sgs", "one coloured symmetric block Gauss-Seidel sweep from zero (HOT Table 3)",
+                                  sgs_create, sgs_setup, sgs_apply, sgs_view, sgs_destroy};

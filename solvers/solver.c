@@ -7,175 +7,115 @@
 
 #include "core/error.h"
 
-const char *solve_status_name(SolveStatus s)
-{
-    switch (s) {
-    case SOLVE_CONVERGED: return "converged";
-    case SOLVE_CAPPED: return "capped";
-    case SOLVE_STALLED: return "stalled";
-    default: return "failed";
-    }
-}
-
 void solve_settings_default(SolveSettings *s)
 {
+    memset(s, 0, sizeof *s);
     s->eps = 1e-7;
     s->max_outer = 10000;
     s->max_linear = 10000;
-    s->armijo = 0;
     s->max_halvings = 60;
 }
 
-int solver_create(const SolverPreset *preset, const SolverOptions *opts, Solver **out)
+int solve_settings_check(const SolveSettings *s)
 {
+    if (!(s->eps > 0.0) || !isfinite(s->eps))
+        return mpm_error(MPM_EINPUT, "--eps %g: expected a positive number", s->eps);
+    if (s->eps < SOLVE_EPS_MIN)
+        return mpm_error(MPM_EINPUT,
+                         "--eps %g: below %.3g, the smallest CN residual double precision resolves (DBL_EPSILON / 24)",
+                         s->eps, SOLVE_EPS_MIN);
+    if (s->max_outer < 1) return mpm_error(MPM_EINPUT, "--max-outer %d: expected >= 1", s->max_outer);
+    if (s->max_linear < 1) return mpm_error(MPM_EINPUT, "--max-linear %d: expected >= 1", s->max_linear);
+    if (s->max_halvings < 0) return mpm_error(MPM_EINPUT, "max_halvings %d: expected >= 0", s->max_halvings);
+    return MPM_OK;
+}
+
+int solver_create(const char *name, const OuterMethodOps *outer, const InvApproxOps *inverse, const SolverOptions *opts,
+                  Solver **out)
+{
+    *out = NULL;
     Solver *s = calloc(1, sizeof *s);
-    if (!s) return mpm_error(MPM_EINTERNAL, "out of memory creating solver %s", preset->name);
-    s->preset = preset;
+    if (!s) return mpm_error(MPM_EINTERNAL, "out of memory creating solver %s", name);
+    snprintf(s->name, sizeof s->name, "%s", name);
     if (opts) s->opts = *opts;
-    int status = MPM_OK;
-    s->window = 8;
-    if (preset->method == METHOD_LBFGS) {
-        s->window = (int)solver_opt_number(&s->opts, "window", 8, &status);
-        if (status) {
-            free(s);
-            return status;
-        }
-        if (s->window < 1 || s->window > 64) {
-            int w = s->window;
-            free(s);
-            return mpm_error(MPM_EINPUT, "--solver-opt window=%d: expected 1..64", w);
-        }
+    int st = MPM_OK;
+    const char *ls = solver_opt_string(&s->opts, "linesearch", "halving");
+    const char *stop = solver_opt_string(&s->opts, "stop", "cn");
+    s->stall_iters = solver_opt_int(&s->opts, "stall_iters", 20, 1, 1000000, &st);
+    if (!st && !(s->ls = line_search_find(ls)))
+        st = mpm_error(MPM_EINPUT, "solver option linesearch=%s: unknown line search (see: mpmbench list solvers)", ls);
+    if (!st && !(s->stop = stop_rule_find(stop)))
+        st = mpm_error(MPM_EINPUT, "solver option stop=%s: unknown stopping rule (see: mpmbench list solvers)", stop);
+    s->stop_tol = NAN;
+    if (!st && s->stop->tol_key) {
+        s->stop_tol = solver_opt_number(&s->opts, s->stop->tol_key, s->stop->tol_default, &st);
+        if (!st && !(s->stop_tol > 0.0))
+            st = mpm_error(MPM_EINPUT, "solver option %s=%g: expected a positive number", s->stop->tol_key, s->stop_tol);
     }
-    if (preset->inv && (status = preset->inv->create(&s->opts, &s->inv))) {
-        free(s);
-        return status;
-    }
-    if ((status = solver_opts_check_used(&s->opts, preset->name))) {
+    if (!st) st = outer->create(&s->opts, &s->outer);
+    if (!st) s->outer->ops = outer;
+    if (!st) st = inv_create(inverse, &s->opts, &s->inv);
+    if (!st && (s->inv->caps & INV_NEEDS_MATRIX) && !s->outer->assembled)
+        st = mpm_error(MPM_EINPUT,
+                       "solver %s: inverse approximation '%s' needs the assembled Hessian, which outer method '%s' "
+                       "does not build (matrix-free)",
+                       name, inverse->name, outer->name);
+    if (!st) st = solver_opts_check_used(&s->opts, name);
+    if (st) {
         solver_destroy(s);
-        return status;
+        return st;
     }
     *out = s;
     return MPM_OK;
-}
-
-int solver_should_stop(StepProblem *pb, const SolveSettings *set, const double *g, double E, int it, double t_start,
-                       IterHook hook, void *hook_ctx, SolveStats *st)
-{
-    double res = problem_cn_residual(pb, g);
-    st->residual = res;
-    if (hook) hook(hook_ctx, it, omp_get_wtime() - t_start, res, E);
-    if (!isfinite(res) || !isfinite(E)) {
-        st->status = SOLVE_FAILED;
-        return 1;
-    }
-    if (res < set->eps) {
-        st->status = SOLVE_CONVERGED;
-        return 1;
-    }
-    if (it >= set->max_outer) {
-        st->status = SOLVE_CAPPED;
-        return 1;
-    }
-    return 0;
-}
-
-int solver_reserve(Solver *s, int n)
-{
-    if (n <= s->cap_nodes) return MPM_OK;
-    int cap = n + n / 4 + 256;
-    size_t v = sizeof(double) * 3 * (size_t)cap;
-    double **vecs[] = {&s->g, &s->p, &s->dv_new, &s->g_new};
-    for (size_t k = 0; k < sizeof vecs / sizeof vecs[0]; ++k) {
-        double *q = realloc(*vecs[k], v);
-        if (!q) return mpm_error(MPM_EINTERNAL, "out of memory: solver vectors (%d nodes)", n);
-        *vecs[k] = q;
-    }
-    double *d = realloc(s->diag, 3 * v);
-    if (!d) return mpm_error(MPM_EINTERNAL, "out of memory: solver diagonal");
-    s->diag = d;
-    if (s->preset->method == METHOD_LBFGS) {
-        size_t hist = v * (size_t)s->window;
-        double *S = realloc(s->S, hist), *Y = S ? realloc(s->Y, hist) : NULL;
-        if (!S || !Y) return mpm_error(MPM_EINTERNAL, "out of memory: L-BFGS history");
-        s->S = S;
-        s->Y = Y;
-        if (!s->rho_hist) {
-            s->rho_hist = calloc((size_t)s->window, sizeof(double));
-            s->xi = calloc((size_t)s->window, sizeof(double));
-            if (!s->rho_hist || !s->xi) return mpm_error(MPM_EINTERNAL, "out of memory: L-BFGS history");
-        }
-    }
-    s->cap_nodes = cap;
-    return MPM_OK;
-}
-
-static void apply_assembled(const void *ctx, const double *x, double *y) { bsr_spmv((const Bsr *)ctx, x, y); }
-
-static void apply_matrix_free(const void *ctx, const double *x, double *y)
-{
-    problem_hessvec((StepProblem *)ctx, x, y);
-}
-
-static void apply_projection(const void *ctx, double *v) { problem_project((const StepProblem *)ctx, v); }
-
-void solver_hessian_op(Solver *s, StepProblem *pb, int assembled, LinearOp *op)
-{
-    op->n_nodes = pb->n_nodes;
-    op->apply = assembled ? apply_assembled : apply_matrix_free;
-    op->ctx = assembled ? (const void *)&s->H : (const void *)pb;
-}
-
-void solver_projection(StepProblem *pb, Projection *P)
-{
-    P->apply = pb->n_dirichlet ? apply_projection : NULL;
-    P->ctx = pb;
-}
-
-int solver_setup_inverse(Solver *s, StepProblem *pb, int assembled, LinearOp *op, Projection *proj)
-{
-    if (assembled) bsr_diagonal(&s->H, s->diag);
-    else problem_diagonal(pb, s->diag);
-    if (!s->inv) return MPM_OK;
-    InvSetupInput in = {
-        .n_nodes = pb->n_nodes,
-        .H = assembled ? &s->H : NULL,
-        .diag = s->diag,
-        .coord = pb->grid->coord,
-        .coloring = &pb->grid->coloring,
-        .op = op,
-        .proj = proj,
-        .problem = pb,
-    };
-    return s->inv->ops->setup(s->inv, &in);
 }
 
 int solver_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv, SolveStats *st, IterHook hook,
                  void *hook_ctx)
 {
     memset(st, 0, sizeof *st);
-    int status = solver_reserve(s, pb->n_nodes);
-    if (status) return status;
-    switch (s->preset->method) {
-    case METHOD_PN: return pn_solve(s, pb, set, dv, st, hook, hook_ctx);
-    case METHOD_LBFGS: return lbfgs_solve(s, pb, set, dv, st, hook, hook_ctx);
-    default: return mpm_error(MPM_EINTERNAL, "solver %s: outer method not available", s->preset->name);
+    SolveCtx c = {
+        .pb = pb,
+        .inv = s->inv,
+        .ls = s->ls,
+        .stop = s->stop,
+        .stop_tol = isnan(s->stop_tol) ? set->eps : s->stop_tol,
+        .stall_iters = s->stall_iters,
+        .set = set,
+        .hook = hook,
+        .hook_ctx = hook_ctx,
+        .t_start = omp_get_wtime(),
+        .best_energy = INFINITY,
+        .best_residual = INFINITY,
+    };
+    long inner0 = inv_inner_iters(s->inv);
+    int status = s->outer->ops->solve(s->outer, &c, dv, st);
+    st->inner_iters = inv_inner_iters(s->inv) - inner0;
+    if (status == MPM_ENUMERIC) {
+        /* a breakdown of this step, not of the program: the step's status */
+        st->status = SOLVE_FAILED;
+        snprintf(st->reason, sizeof st->reason, "%s", mpm_last_error());
+        mpm_clear_error();
+        status = MPM_OK;
     }
+    return status;
+}
+
+void solver_view(const Solver *s, FILE *f, InvView *inv_view_out)
+{
+    if (f) {
+        fprintf(f, "solver %s: outer method %s x inverse approximation %s; line search %s; stop %s", s->name,
+                s->outer->ops->name, s->inv->ops->name, s->ls->name, s->stop->name);
+        if (!isnan(s->stop_tol)) fprintf(f, " (%s = %g)", s->stop->tol_key, s->stop_tol);
+        fprintf(f, "; stalled after %d iterations without progress\n", s->stall_iters);
+        if (s->outer->ops->view) s->outer->ops->view(s->outer, f);
+    }
+    inv_view(s->inv, f, inv_view_out);
 }
 
 void solver_destroy(Solver *s)
 {
     if (!s) return;
-    if (s->inv) s->inv->ops->destroy(s->inv);
-    bsr_free(&s->H);
-    pcg_work_free(&s->pcg);
-    free(s->g);
-    free(s->p);
-    free(s->dv_new);
-    free(s->g_new);
-    free(s->diag);
-    free(s->S);
-    free(s->Y);
-    free(s->rho_hist);
-    free(s->xi);
+    if (s->outer) s->outer->ops->destroy(s->outer);
+    inv_destroy(s->inv);
     free(s);
 }

@@ -1,92 +1,56 @@
-/* A named solver = an outer method x an inverse-Hessian approximation x
- * options (DESIGN "the one idea"). The registry of presets lives in
- * experiments/registry.c; this file is the run-time object. */
+/* A solver = an outer method x an inverse approximation x strategies x
+ * options (DESIGN "the one idea"). This file composes and runs the parts;
+ * which parts exist by name is experiments/registry.c's business (the only
+ * file that knows every implementation), so solvers/ knows no adapter. */
 #ifndef MPM_SOLVER_H
 #define MPM_SOLVER_H
 
-#include <stdint.h>
+#include <float.h>
 
-#include "core/bsr.h"
-#include "core/problem.h"
 #include "solvers/inverse_approx.h"
-#include "solvers/pcg.h"
+#include "solvers/outer_method.h"
 
-typedef enum { METHOD_PN = 0, METHOD_LBFGS = 1, METHOD_GAST15 = 2 } OuterMethod;
+/* The smallest CN tolerance the run accepts. The CN residual (SPEC 4) is the
+ * gradient divided by kappa_i = 24 dx^2 dt abar_i. A change of F_p by one
+ * unit in the last place of F ~ I, i.e. a strain of DBL_EPSILON, changes the
+ * stress by at most abar DBL_EPSILON and the node force by about
+ * dt dx^2 abar DBL_EPSILON (sum_p V_p |grad w_ip| ~ dx^2), hence the scaled
+ * residual by about DBL_EPSILON / 24: below that, dv cannot be refined by any
+ * representable change of F, and the test compares rounding noise. */
+#define SOLVE_EPS_MIN (DBL_EPSILON / 24.0)
 
-typedef enum { SOLVE_CONVERGED = 0, SOLVE_CAPPED, SOLVE_STALLED, SOLVE_FAILED } SolveStatus;
-const char *solve_status_name(SolveStatus s);
-
-typedef struct {
-    const char *name;
-    const char *description;
-    OuterMethod method;
-    const InvApproxOps *inv;  /* PCG preconditioner (PN) or initial inverse Hessian (L-BFGS) */
-    int matrix_free;          /* PN: Hessian only as products, preconditioner from the diagonal */
-    const char *defaults;     /* "key=value,key=value" preset options (overridable) */
-} SolverPreset;
-
-typedef struct {
-    double eps;           /* CN tolerance (SPEC 4), default 1e-7 */
-    int max_outer;        /* 10000 */
-    int max_linear;       /* 10000 */
-    int armijo;           /* line-search rule (SPEC 5) */
-    int max_halvings;     /* 60 */
-} SolveSettings;
-
-typedef struct {
-    int outer_iters;
-    long linear_iters;
-    int ls_evals;
-    double residual;      /* scaled CN residual at the returned dv */
-    SolveStatus status;
-    double assemble_s, setup_s, solve_s, linesearch_s;
-    int64_t hessian_blocks;
-    size_t hessian_bytes;
-} SolveStats;
-
-/* Called at every outer iteration with the CN residual and energy. */
-typedef void (*IterHook)(void *ctx, int iter, double elapsed_s, double residual, double energy);
+/* MPM_EINPUT with one line naming the setting when a value is out of range
+ * (eps below SOLVE_EPS_MIN, non-positive caps). */
+int solve_settings_check(const SolveSettings *s);
+void solve_settings_default(SolveSettings *s);
 
 typedef struct Solver {
-    const SolverPreset *preset;
-    SolverOptions opts;
+    char name[96];              /* preset name or the spec, for messages */
+    OuterMethod *outer;
     InvApprox *inv;
-    Bsr H;
-    PcgWork pcg;
-    int cap_nodes;
-    double *g, *p, *dv_new, *g_new, *diag; /* 3n / 9n work vectors */
-    /* L-BFGS history */
-    int window;
-    double *S, *Y, *rho_hist, *xi;        /* window x 3n, window */
+    const LineSearchOps *ls;
+    const StopRuleOps *stop;
+    double stop_tol;            /* NAN: the run's eps (rule "cn") */
+    int stall_iters;
+    SolverOptions opts;         /* every option consulted, with the value in effect */
 } Solver;
 
-void solve_settings_default(SolveSettings *s);
-int solver_create(const SolverPreset *preset, const SolverOptions *opts, Solver **out);
-/* Minimises the step problem from dv (in: initial guess, out: solution). */
-int solver_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv, SolveStats *st,
-                 IterHook hook, void *hook_ctx);
+/* Creates outer x inverse with the options (consumed: a key no part reads is
+ * an error). The generic options read here: linesearch (halving), stop (cn),
+ * its tolerance key (l2: tau), stall_iters (20). An inverse approximation
+ * needing the assembled matrix with a matrix-free outer method is refused
+ * with one line naming both. Needs no step problem. */
+int solver_create(const char *name, const OuterMethodOps *outer, const InvApproxOps *inverse, const SolverOptions *opts,
+                  Solver **out);
+/* Minimises the step problem from dv (in: initial guess, out: the last
+ * accepted iterate). A numerical breakdown inside (MPM_ENUMERIC) becomes
+ * st->status failed with the message as st->reason and returns MPM_OK; other
+ * errors are returned. */
+int solver_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv, SolveStats *st, IterHook hook,
+                 void *hook_ctx);
+/* Prints the composition and the parts' views to f (when not NULL) and
+ * returns the inverse approximation's view (when not NULL). */
+void solver_view(const Solver *s, FILE *f, InvView *inv_view);
 void solver_destroy(Solver *s);
-
-/* Outer methods (one file each). */
-int pn_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv, SolveStats *st, IterHook hook,
-             void *hook_ctx);
-
-int lbfgs_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv, SolveStats *st, IterHook hook,
-                void *hook_ctx);
-
-/* The stopping test every outer method runs at the top of iteration `it`
- * (SPEC 4, 5): records the CN residual of g in st and calls the hook; returns
- * 1 with st->status set when the solve ends here (converged, failed on a
- * non-finite residual or energy, or capped at max_outer), 0 to iterate. */
-int solver_should_stop(StepProblem *pb, const SolveSettings *set, const double *g, double E, int it, double t_start,
-                       IterHook hook, void *hook_ctx, SolveStats *st);
-/* Shared by the outer methods: grows work vectors to n nodes. */
-int solver_reserve(Solver *s, int n_nodes);
-/* The BC-projected Hessian as a LinearOp (assembled or matrix-free). */
-void solver_hessian_op(Solver *s, StepProblem *pb, int assembled, LinearOp *op);
-/* Projection onto free dofs as a Projection. */
-void solver_projection(StepProblem *pb, Projection *P);
-/* Sets up the inverse approximation at the current tangent; fills diag. */
-int solver_setup_inverse(Solver *s, StepProblem *pb, int assembled, LinearOp *op, Projection *proj);
 
 #endif

@@ -92,13 +92,13 @@ static void test_cholmod(SynthProblem *p)
     const size_t len = 3 * (size_t)p->n;
     double *b = malloc(sizeof(double) * len), *x = malloc(sizeof(double) * len);
     InvApprox *C = NULL;
-    int st = inv_cholmod_ops.create(NULL, &C);
+    int st = inv_create(&inv_cholmod_ops, NULL, &C);
     CHECK(st == MPM_OK && C && strcmp(C->ops->name, "cholmod") == 0, "cholmod create: %s", mpm_last_error());
     if (st) return;
     InvSetupInput in = input_of(p);
 
     /* first factorisation */
-    st = C->ops->setup(C, &in);
+    st = inv_setup(C, &in);
     CHECK(st == MPM_OK, "cholmod setup: %s", mpm_last_error());
     double lnz = 0.0;
     int n_an = -1;
@@ -107,7 +107,7 @@ static void test_cholmod(SynthProblem *p)
     CHECK(lnz >= 0.5 * (double)(9 * p->A.nnzb + 3 * p->n) / 2, "factor nnz %g smaller than the lower triangle", lnz);
     synth_random_vector(p->n, 7, b);
     double t_apply = 0.0;
-    st = C->ops->apply(C, b, x);
+    st = inv_apply(C, b, x);
     t_apply = C->stats.apply_s;
     double res = rel_residual(&p->A, b, x);
     CHECK(st == MPM_OK && res < 1e-10, "cholmod solve: status %d, ||Ax-b||/||b|| = %g", st, res);
@@ -117,10 +117,10 @@ static void test_cholmod(SynthProblem *p)
 
     /* same pattern, new values: numeric refactorisation only */
     shift_diagonal(p, 0.5);
-    st = C->ops->setup(C, &in);
+    st = inv_setup(C, &in);
     cholmod_direct_info(C, NULL, &n_an);
     CHECK(st == MPM_OK && n_an == 1, "same pattern must not re-analyse: status %d, analyses %d", st, n_an);
-    st = C->ops->apply(C, b, x);
+    st = inv_apply(C, b, x);
     res = rel_residual(&p->A, b, x);
     CHECK(st == MPM_OK && res < 1e-10, "refactorised solve: ||Ax-b||/||b|| = %g", res);
     printf("cholmod: refactorisation with the same pattern %.3f s (analyses %d)\n", C->stats.setup_s, n_an);
@@ -134,12 +134,12 @@ static void test_cholmod(SynthProblem *p)
         st = synth_build(&q, &sq);
         CHECK(st == MPM_OK, "synth q: %s", mpm_last_error());
         InvSetupInput iq = input_of(&q);
-        st = C->ops->setup(C, &iq);
+        st = inv_setup(C, &iq);
         cholmod_direct_info(C, NULL, &n_an);
         CHECK(st == MPM_OK && n_an == 2, "new pattern must re-analyse: status %d, analyses %d", st, n_an);
         double *bq = malloc(sizeof(double) * 3 * (size_t)q.n), *xq = malloc(sizeof(double) * 3 * (size_t)q.n);
         synth_random_vector(q.n, 8, bq);
-        st = C->ops->apply(C, bq, xq);
+        st = inv_apply(C, bq, xq);
         res = rel_residual(&q.A, bq, xq);
         CHECK(st == MPM_OK && res < 1e-10, "solve after the pattern change: ||Ax-b||/||b|| = %g", res);
         free(bq);
@@ -157,22 +157,22 @@ static void test_cholmod(SynthProblem *p)
         memcpy(saved, p->A.val + 9 * k, sizeof saved);
         for (int d = 0; d < 9; ++d) p->A.val[9 * k + d] = -saved[d]; /* symmetric, not positive definite */
         mpm_clear_error();
-        st = C->ops->setup(C, &in);
+        st = inv_setup(C, &in);
         char want[32];
         snprintf(want, sizeof want, "node %d ", node);
-        CHECK(st == MPM_EINTERNAL && strstr(mpm_last_error(), "not positive definite") &&
+        CHECK(st == MPM_ENUMERIC && strstr(mpm_last_error(), "not positive definite") &&
                   strstr(mpm_last_error(), want),
               "indefinite matrix: status %d, message '%s'", st, mpm_last_error());
         printf("cholmod on an indefinite matrix (node %d negated): '%s'\n", node, mpm_last_error());
         cholmod_direct_info(C, NULL, &n_an);
         CHECK(n_an == 3, "pattern back: analyses %d", n_an);
         mpm_clear_error();
-        st = C->ops->apply(C, b, x);
+        st = inv_apply(C, b, x);
         CHECK(st == MPM_EINTERNAL, "apply after a failed setup must fail, got %d", st);
         mpm_clear_error();
         memcpy(p->A.val + 9 * k, saved, sizeof saved);
-        st = C->ops->setup(C, &in);
-        st |= C->ops->apply(C, b, x);
+        st = inv_setup(C, &in);
+        st |= inv_apply(C, b, x);
         res = rel_residual(&p->A, b, x);
         cholmod_direct_info(C, NULL, &n_an);
         CHECK(st == MPM_OK && res < 1e-10 && n_an == 4, "recovery after failure: status %d, residual %g, analyses %d",
@@ -183,12 +183,12 @@ static void test_cholmod(SynthProblem *p)
         InvSetupInput mf = in;
         mf.H = NULL;
         mpm_clear_error();
-        CHECK(C->ops->setup(C, &mf) == MPM_EINTERNAL, "matrix-free cholmod must fail");
+        CHECK(inv_setup(C, &mf) == MPM_EINTERNAL, "matrix-free cholmod must fail");
         mpm_clear_error();
     }
     CHECK(cholmod_direct_info(NULL, NULL, NULL) == MPM_EINTERNAL, "info on NULL");
     mpm_clear_error();
-    C->ops->destroy(C);
+    inv_destroy(C);
     free(b);
     free(x);
 }
@@ -202,19 +202,19 @@ static void test_boomeramg(SynthProblem *p)
 
     /* exact solution from CHOLMOD */
     InvApprox *C = NULL;
-    int st = inv_cholmod_ops.create(NULL, &C);
-    st |= C->ops->setup(C, &in);
+    int st = inv_create(&inv_cholmod_ops, NULL, &C);
+    st |= inv_setup(C, &in);
     synth_random_vector(p->n, 21, b);
     projection_apply(&p->proj, b);
-    st |= C->ops->apply(C, b, x);
+    st |= inv_apply(C, b, x);
     CHECK(st == MPM_OK, "cholmod reference: %s", mpm_last_error());
-    C->ops->destroy(C);
+    inv_destroy(C);
 
     InvApprox *M = NULL;
-    st = inv_boomeramg_ops.create(NULL, &M);
+    st = inv_create(&inv_boomeramg_ops, NULL, &M);
     CHECK(st == MPM_OK && M && strcmp(M->ops->name, "boomeramg") == 0, "boomeramg create: %s", mpm_last_error());
     if (st) return;
-    st = M->ops->setup(M, &in);
+    st = inv_setup(M, &in);
     CHECK(st == MPM_OK, "boomeramg setup: %s", mpm_last_error());
     if (st) return;
     int levels = 0;
@@ -224,7 +224,7 @@ static void test_boomeramg(SynthProblem *p)
     double t_setup = M->stats.setup_s;
 
     /* one V-cycle from zero: A-norm error reduction */
-    st = M->ops->apply(M, b, z);
+    st = inv_apply(M, b, z);
     CHECK(st == MPM_OK, "boomeramg apply: %s", mpm_last_error());
     double t_apply = M->stats.apply_s;
     for (size_t k = 0; k < len; ++k) y[k] = x[k] - z[k];
@@ -247,8 +247,8 @@ static void test_boomeramg(SynthProblem *p)
             projection_apply(&p->proj, x);
             projection_apply(&p->proj, y);
         }
-        st = M->ops->apply(M, x, Mx);
-        st |= M->ops->apply(M, y, My);
+        st = inv_apply(M, x, Mx);
+        st |= inv_apply(M, y, My);
         double xMy = vec_dot(len, x, My), yMx = vec_dot(len, y, Mx), xMx = vec_dot(len, x, Mx);
         double scale = sqrt(fabs(xMx) * fabs(vec_dot(len, y, My)));
         CHECK(st == MPM_OK && fabs(xMy - yMx) <= 1e-8 * scale, "symmetry: x^T M y %.17g vs y^T M x %.17g (scale %g)",
@@ -259,14 +259,14 @@ static void test_boomeramg(SynthProblem *p)
                    fabs(xMy - yMx) / scale);
     }
     /* deterministic: the same input gives the same output */
-    st = M->ops->apply(M, b, y);
+    st = inv_apply(M, b, y);
     CHECK(st == MPM_OK && memcmp(y, z, sizeof(double) * len) == 0, "repeated application differs");
 
     /* PN-AMG-PCG vs PN-PCG (block Jacobi) */
     {
         InvApprox *J = NULL;
-        inv_block_jacobi_ops.create(NULL, &J);
-        st = J->ops->setup(J, &in);
+        inv_create(&inv_block_jacobi_ops, NULL, &J);
+        st = inv_setup(J, &in);
         CHECK(st == MPM_OK, "jacobi setup");
         PcgWork w = {0};
         PcgResult rj = run_pcg(p, J, b, x, &w);
@@ -281,7 +281,7 @@ static void test_boomeramg(SynthProblem *p)
               rj.iters);
         CHECK(resa < 1e-6, "AMG-PCG solution residual %g", resa);
         pcg_work_free(&w);
-        J->ops->destroy(J);
+        inv_destroy(J);
     }
 
     /* the matrix hypre holds is H */
@@ -301,7 +301,7 @@ static void test_boomeramg(SynthProblem *p)
     /* repeated setups: same pattern, new pattern, back */
     {
         shift_diagonal(p, 0.5);
-        st = M->ops->setup(M, &in);
+        st = inv_setup(M, &in);
         CHECK(st == MPM_OK, "re-setup with the same pattern: %s", mpm_last_error());
         printf("boomeramg: re-setup with the same pattern %.3f s\n", M->stats.setup_s);
         PcgWork w = {0};
@@ -314,7 +314,7 @@ static void test_boomeramg(SynthProblem *p)
                           .dirichlet = 1, .seed = 5};
         st = synth_build(&q, &sq);
         InvSetupInput iq = input_of(&q);
-        st |= M->ops->setup(M, &iq);
+        st |= inv_setup(M, &iq);
         CHECK(st == MPM_OK, "setup on a new pattern: %s", mpm_last_error());
         double *bq = malloc(sizeof(double) * 3 * (size_t)q.n), *xq = malloc(sizeof(double) * 3 * (size_t)q.n);
         synth_random_vector(q.n, 9, bq);
@@ -325,7 +325,7 @@ static void test_boomeramg(SynthProblem *p)
         free(xq);
         synth_free(&q);
 
-        st = M->ops->setup(M, &in);
+        st = inv_setup(M, &in);
         r2 = run_pcg(p, M, b, x, &w);
         CHECK(st == MPM_OK && rel_residual(&p->A, b, x) < 1e-6, "AMG-PCG back on the first pattern");
         pcg_work_free(&w);
@@ -333,12 +333,12 @@ static void test_boomeramg(SynthProblem *p)
         InvSetupInput mf = in;
         mf.H = NULL;
         mpm_clear_error();
-        CHECK(M->ops->setup(M, &mf) == MPM_EINTERNAL, "matrix-free boomeramg must fail");
+        CHECK(inv_setup(M, &mf) == MPM_EINTERNAL, "matrix-free boomeramg must fail");
         mpm_clear_error();
-        CHECK(M->ops->apply(M, b, x) == MPM_EINTERNAL, "apply after a failed setup must fail");
+        CHECK(inv_apply(M, b, x) == MPM_EINTERNAL, "apply after a failed setup must fail");
         mpm_clear_error();
     }
-    M->ops->destroy(M);
+    inv_destroy(M);
 
     /* option variants all give a working preconditioner */
     {
@@ -354,10 +354,10 @@ static void test_boomeramg(SynthProblem *p)
             add_opt(&o, variants[v][0][0], variants[v][0][1]);
             add_opt(&o, variants[v][1][0], variants[v][1][1]);
             InvApprox *V = NULL;
-            st = inv_boomeramg_ops.create(&o, &V);
+            st = inv_create(&inv_boomeramg_ops, &o, &V);
             CHECK(st == MPM_OK, "create with %s=%s: %s", o.key[0], o.value[0], mpm_last_error());
             if (st) continue;
-            st = V->ops->setup(V, &in);
+            st = inv_setup(V, &in);
             CHECK(st == MPM_OK, "setup with %s=%s %s=%s: %s", o.key[0], o.value[0], o.key[1], o.value[1],
                   mpm_last_error());
             if (!st) {
@@ -369,7 +369,7 @@ static void test_boomeramg(SynthProblem *p)
                 CHECK(rel_residual(&p->A, b, x) < 1e-6, "variant %zu residual", v);
                 pcg_work_free(&w);
             }
-            V->ops->destroy(V);
+            inv_destroy(V);
         }
         static const char *bad[][2] = {{"amg_coarsen", "RS"},           {"amg_nodal", "5"},     {"amg_relax", "3"},
                                        {"amg_strong_threshold", "1.5"}, {"amg_agg_levels", "-1"}, {"amg_sweeps", "x"},
@@ -379,7 +379,7 @@ static void test_boomeramg(SynthProblem *p)
             add_opt(&o, bad[v][0], bad[v][1]);
             InvApprox *V = NULL;
             mpm_clear_error();
-            st = inv_boomeramg_ops.create(&o, &V);
+            st = inv_create(&inv_boomeramg_ops, &o, &V);
             CHECK(st == MPM_EINPUT && strstr(mpm_last_error(), bad[v][0]), "%s=%s must be rejected: %d '%s'",
                   bad[v][0], bad[v][1], st, mpm_last_error());
             mpm_clear_error();
@@ -438,24 +438,24 @@ static void test_mpm_hessian(void)
            pb->n_dirichlet, (long long)H.nnzb, (double)H.nnzb / n, o.dt);
 
     InvApprox *C = NULL;
-    st = inv_cholmod_ops.create(NULL, &C);
-    st |= C->ops->setup(C, &in);
-    st |= C->ops->apply(C, b, x);
+    st = inv_create(&inv_cholmod_ops, NULL, &C);
+    st |= inv_setup(C, &in);
+    st |= inv_apply(C, b, x);
     double res = rel_residual(&H, b, x), lnz = 0;
     cholmod_direct_info(C, &lnz, NULL);
     CHECK(st == MPM_OK && res < 1e-10, "cholmod on the MPM Hessian: %s, residual %g", mpm_last_error(), res);
     printf("MPM Hessian, cholmod: factor nnz %.4g, setup %.3f s, apply %.4f s, residual %.1e\n", lnz,
            C->stats.setup_s, C->stats.apply_s, res);
-    C->ops->destroy(C);
+    inv_destroy(C);
 
     PcgWork w = {0};
     InvApprox *J = NULL;
-    inv_block_jacobi_ops.create(NULL, &J);
-    st = J->ops->setup(J, &in);
+    inv_create(&inv_block_jacobi_ops, NULL, &J);
+    st = inv_setup(J, &in);
     PcgResult rj = run_pcg(&view, J, b, x, &w);
     printf("MPM Hessian, PCG to 1e-8: block Jacobi %d iterations (%.3f s apply total)\n", rj.iters,
            J->stats.apply_s);
-    J->ops->destroy(J);
+    inv_destroy(J);
     static const char *nodal[] = {"4", "6", "1", "0", "4 amg_rbm=2"};
     for (size_t v = 0; v < sizeof nodal / sizeof nodal[0]; ++v) {
         SolverOptions so = {0};
@@ -464,11 +464,11 @@ static void test_mpm_hessian(void)
         add_opt(&so, "amg_nodal", nv);
         if (strstr(nodal[v], "amg_rbm=2")) add_opt(&so, "amg_rbm", "2");
         InvApprox *M = NULL;
-        st = inv_boomeramg_ops.create(&so, &M);
-        st |= M->ops->setup(M, &in);
+        st = inv_create(&inv_boomeramg_ops, &so, &M);
+        st |= inv_setup(M, &in);
         CHECK(st == MPM_OK, "boomeramg nodal %s on the MPM Hessian: %s", nodal[v], mpm_last_error());
         if (st) {
-            M->ops->destroy(M);
+            inv_destroy(M);
             continue;
         }
         int levels = 0;
@@ -497,7 +497,7 @@ static void test_mpm_hessian(void)
             CHECK(ra.iters * 2 < rj.iters && resa < 1e-6,
                   "AMG-PCG (%d iterations, residual %g) vs Jacobi-PCG (%d) on the MPM Hessian", ra.iters, resa,
                   rj.iters);
-        M->ops->destroy(M);
+        inv_destroy(M);
     }
     pcg_work_free(&w);
     bsr_free(&H);

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/error.h"
 #include "core/mat3.h"
 #include "experiments/registry.h"
 #include "solvers/solver.h"
@@ -33,11 +34,7 @@ int main(void)
     double *dv = calloc(3 * (size_t)n, sizeof(double));
     problem_initial_guess(pb, dv);
     Solver *s = NULL;
-    SolverOptions so;
-    const SolverPreset *pre = registry_find("pn-pcg");
-    CHECK(pre != NULL, "pn-pcg registered");
-    registry_options(pre, NULL, 0, &so);
-    CHECK(solver_create(pre, &so, &s) == 0, "solver");
+    CHECK(solver_from_spec("pn-pcg", NULL, 0, &s) == 0, "solver pn-pcg: %s", mpm_last_error());
     SolveSettings set;
     solve_settings_default(&set);
     SolveStats st;

@@ -124,11 +124,8 @@ static void slide(const char *friction, int frames, SlideResult *out)
     if (st) return;
     Simulation sim;
     st = sim_init(&sim, &sc);
-    const SolverPreset *pre = registry_find("pn-pcg");
-    SolverOptions so;
-    registry_options(pre, NULL, 0, &so);
     Solver *solver = NULL;
-    if (!st) st = solver_create(pre, &so, &solver);
+    if (!st) st = solver_from_spec("pn-pcg", NULL, 0, &solver);
     SolveSettings set_;
     solve_settings_default(&set_);
     set_.eps = 1e-9;

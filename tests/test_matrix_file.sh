@@ -24,7 +24,7 @@ bad unknown-scene 'unknown-scene\.json: axes\.scene\[1\]: unknown scene "dorp"' 
   '{"name": "t", "axes": {"scene": ["drop", "dorp"], "solver": ["hot"]}}'
 bad missing-scene-file 'missing-scene-file\.json: defaults\.scene: scene file "nope/x\.json" not found' \
   '{"name": "t", "defaults": {"scene": "nope/x.json"}, "axes": {"solver": ["hot"]}}'
-bad unknown-solver 'unknown-solver\.json: axes\.solver\[0\]: unknown solver "hott"' \
+bad unknown-solver 'unknown-solver\.json: axes\.solver\[0\]: unknown solver .hott.' \
   '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hott"]}}'
 bad empty-axis 'empty-axis\.json: axes\.solver: empty list' '{"name": "t", "axes": {"scene": ["drop"], "solver": []}}'
 bad empty-set-axis 'empty-set-axis\.json: axes\.sets\.stiff: empty list' \
@@ -67,7 +67,7 @@ bad malformed 'malformed\.json:1:[0-9]+: malformed JSON' '{"name": "t",, }'
 bad solver-opt 'solver-opt\.json: solver "pn-pcg" \(axes\.solver\[1\]\) with solver options levels=3 \(defaults\.solver_opts\.levels\): .*pn-pcg has no option .levels.' \
   '{"name": "t", "defaults": {"solver_opts": {"levels": 3}}, "axes": {"scene": ["drop"], "solver": ["hot", "pn-pcg"]}}'
 # ... or a value the solver cannot run with
-bad solver-value 'solver-value\.json: solver "hot" \(axes\.solver\[0\]\) with solver options window=100 \(axes\.solver_opts\.w\[0\]\.window\): --solver-opt window=100: expected 1\.\.64' \
+bad solver-value 'solver-value\.json: solver "hot" \(axes\.solver\[0\]\) with solver options window=100 \(axes\.solver_opts\.w\[0\]\.window\): solver option window=100: expected an integer in \[1, 64\]' \
   '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hot"], "solver_opts": {"w": [{"window": 100}]}}}'
 # scenes are loaded at the cell's scale with its overrides
 bad set-path 'set-path\.json: scene "drop" \(axes\.scene\[0\]\) at scale 3 with set materials\.sof\.E=5 \(axes\.sets\.e\[0\]\.materials\.sof\.E\): .*materials\.sof' \

@@ -182,20 +182,22 @@ static void test_galerkin(const SynthProblem *p, MgEmbedding kind)
 }
 
 /* ---- V-cycle symmetry ---- */
-static void test_vcycle_symmetry(const SynthProblem *p, const InvApproxOps *ops)
+static void test_vcycle_symmetry(const SynthProblem *p, const char *embedding)
 {
     SolverOptions o = {0};
     set_opt(&o, "coarse_exact", "1");
     set_opt(&o, "min_coarse_nodes", "50");
+    set_opt(&o, "embedding", embedding);
     InvApprox *V = NULL;
-    int st = ops->create(&o, &V);
+    int st = inv_create(&inv_mg_ops, &o, &V);
     InvSetupInput in = setup_input(p);
-    st = st ? st : ops->setup(V, &in);
-    CHECK(st == MPM_OK, "%s setup: %s", ops->name, mpm_last_error());
+    st = st ? st : inv_setup(V, &in);
+    CHECK(st == MPM_OK, "mg %s setup: %s", embedding, mpm_last_error());
     if (st) return;
-    MgInfo info;
-    mg_get_info(V, &info);
-    CHECK(info.n_levels == 3, "%s: expected 3 levels, got %d", ops->name, info.n_levels);
+    CHECK((V->caps & INV_SYMMETRIC) && !(V->caps & INV_VARIABLE), "coarse_exact=1 claims a fixed symmetric map");
+    InvView info;
+    inv_view(V, NULL, &info);
+    CHECK(info.n_levels == 3, "mg %s: expected 3 levels, got %d", embedding, info.n_levels);
     size_t len = 3 * (size_t)p->n;
     double *x = malloc(sizeof(double) * len), *y = malloc(sizeof(double) * len);
     double *Vx = malloc(sizeof(double) * len), *Vy = malloc(sizeof(double) * len), *V2 = malloc(sizeof(double) * len);
@@ -204,25 +206,25 @@ static void test_vcycle_symmetry(const SynthProblem *p, const InvApproxOps *ops)
         synth_random_vector(p->n, 80 + trial, y);
         projection_apply(&p->proj, x);
         projection_apply(&p->proj, y);
-        V->ops->apply(V, x, Vx);
-        V->ops->apply(V, y, Vy);
+        inv_apply(V, x, Vx);
+        inv_apply(V, y, Vy);
         double xVy = vec_dot(len, x, Vy), yVx = vec_dot(len, y, Vx), xVx = vec_dot(len, x, Vx);
-        CHECK(rel_diff(xVy, yVx, 1e-300) < 1e-8, "%s exact-coarse V-cycle symmetry: %.15g vs %.15g", ops->name, xVy,
-              yVx);
-        CHECK(xVx > 0.0, "%s: x^T V x = %g", ops->name, xVx);
+        CHECK(rel_diff(xVy, yVx, 1e-300) < 1e-8, "mg %s exact-coarse V-cycle symmetry: %.15g vs %.15g", embedding,
+              xVy, yVx);
+        CHECK(xVx > 0.0, "mg %s: x^T V x = %g", embedding, xVx);
         if (trial == 0)
-            printf("%s exact-coarse V-cycle: x^T V y = %.15g, y^T V x = %.15g (rel %.2g)\n", ops->name, xVy, yVx,
+            printf("mg %s exact-coarse V-cycle: x^T V y = %.15g, y^T V x = %.15g (rel %.2g)\n", embedding, xVy, yVx,
                    rel_diff(xVy, yVx, 1e-300));
     }
     /* reproducible run to run */
-    V->ops->apply(V, x, V2);
-    CHECK(memcmp(Vx, V2, sizeof(double) * len) == 0, "%s: V-cycle not reproducible", ops->name);
+    inv_apply(V, x, V2);
+    CHECK(memcmp(Vx, V2, sizeof(double) * len) == 0, "mg %s: V-cycle not reproducible", embedding);
     free(x);
     free(y);
     free(Vx);
     free(Vy);
     free(V2);
-    V->ops->destroy(V);
+    inv_destroy(V);
 }
 
 /* ---- PCG comparisons ---- */
@@ -233,15 +235,19 @@ typedef struct {
     double relres;
 } SolveStat;
 
-static SolveStat pcg_with(const SynthProblem *p, const InvApproxOps *ops, SolverOptions *o, const double *b,
-                          double *x, double rel_tol, int print_info)
+/* the inverse approximation `ops`, for "mg" with the embedding kernel given */
+static SolveStat pcg_with(const SynthProblem *p, const InvApproxOps *ops, const char *embedding, SolverOptions *o,
+                          const double *b, double *x, double rel_tol, int print_info)
 {
     SolveStat s = {0};
     InvApprox *M = NULL;
-    int st = ops->create(o, &M);
+    SolverOptions opts = {0};
+    if (o) opts = *o;
+    if (embedding) set_opt(&opts, "embedding", embedding);
+    int st = inv_create(ops, &opts, &M);
     InvSetupInput in = setup_input(p);
     double t0 = omp_get_wtime();
-    st = st ? st : ops->setup(M, &in);
+    st = st ? st : inv_setup(M, &in);
     s.setup_s = omp_get_wtime() - t0;
     CHECK(st == MPM_OK, "%s setup: %s", ops->name, mpm_last_error());
     if (st) return s;
@@ -277,13 +283,9 @@ static SolveStat pcg_with(const SynthProblem *p, const InvApproxOps *ops, Solver
     for (int i = 0; i < p->n; ++i)
         if (p->fixed[i] && (x[3 * i] != 0.0 || x[3 * i + 1] != 0.0 || x[3 * i + 2] != 0.0)) fixed_ok = 0;
     CHECK(fixed_ok, "%s: Dirichlet nodes must stay zero", ops->name);
-    if (print_info && (ops == &inv_mg_linear_ops || ops == &inv_mg_quadratic_ops)) {
-        MgInfo info;
-        mg_get_info(M, &info);
-        mg_print_info(&info, stdout);
-    }
+    if (print_info && embedding) inv_view(M, stdout, NULL);
     pcg_work_free(&w);
-    M->ops->destroy(M);
+    inv_destroy(M);
     return s;
 }
 
@@ -292,18 +294,20 @@ static void compare(const SynthProblem *p, double rel_tol, int with_scalar_sgs, 
     size_t len = 3 * (size_t)p->n;
     double *b = malloc(sizeof(double) * len), *x = malloc(sizeof(double) * len);
     synth_random_vector(p->n, 12345, b);
-    const InvApproxOps *ops[4] = {&inv_block_jacobi_ops, &inv_sgs_ops, &inv_mg_linear_ops, &inv_mg_quadratic_ops};
+    const InvApproxOps *ops[4] = {&inv_block_jacobi_ops, &inv_sgs_ops, &inv_mg_ops, &inv_mg_ops};
+    const char *embedding[4] = {NULL, NULL, "linear", "quadratic"};
+    const char *label[4] = {"block-jacobi", "sgs", "mg linear", "mg quadratic"};
     SolveStat s[4];
     for (int k = 0; k < 4; ++k) {
         if (k == 1 && !with_scalar_sgs) {
             memset(&s[k], 0, sizeof s[k]);
             continue;
         }
-        s[k] = pcg_with(p, ops[k], NULL, b, x, rel_tol, 1);
-        CHECK(s[k].relres < 1e3 * rel_tol, "%s: relative residual %g", ops[k]->name, s[k].relres);
+        s[k] = pcg_with(p, ops[k], embedding[k], NULL, b, x, rel_tol, 1);
+        CHECK(s[k].relres < 1e3 * rel_tol, "%s: relative residual %g", label[k], s[k].relres);
         printf("  PCG[%-13s] %5d iterations  rel.res %.2e  setup %.4f s  solve %.4f s  (apply %.4f s, %.2f ms per "
                "application, coarse PCG %ld its)\n",
-               ops[k]->name, s[k].iters, s[k].relres, s[k].setup_s, s[k].solve_s, s[k].apply_s,
+               label[k], s[k].iters, s[k].relres, s[k].setup_s, s[k].solve_s, s[k].apply_s,
                1e3 * s[k].apply_s / (s[k].iters + 1), s[k].inner);
     }
     *it_jac = s[0].iters;
@@ -350,8 +354,8 @@ int main(void)
     }
     test_galerkin(&p, MG_EMBED_LINEAR);
     test_galerkin(&p, MG_EMBED_QUADRATIC);
-    test_vcycle_symmetry(&p, &inv_mg_linear_ops);
-    test_vcycle_symmetry(&p, &inv_mg_quadratic_ops);
+    test_vcycle_symmetry(&p, "linear");
+    test_vcycle_symmetry(&p, "quadratic");
 
     /* options and errors */
     {
@@ -359,25 +363,33 @@ int main(void)
         set_opt(&o, "levels", "0");
         InvApprox *V = NULL;
         mpm_clear_error();
-        CHECK(inv_mg_linear_ops.create(&o, &V) == MPM_EINPUT, "levels=0 must be rejected");
+        CHECK(inv_create(&inv_mg_ops, &o, &V) == MPM_EINPUT, "levels=0 must be rejected");
         SolverOptions o2 = {0};
         set_opt(&o2, "sweeps", "x");
         mpm_clear_error();
-        CHECK(inv_mg_linear_ops.create(&o2, &V) == MPM_EINPUT, "sweeps=x must be rejected");
+        CHECK(inv_create(&inv_mg_ops, &o2, &V) == MPM_EINPUT, "sweeps=x must be rejected");
+        /* integer options are integers in range, never a silent cast */
+        static const char *bad[][2] = {{"levels", "2.5"}, {"sweeps", "1e10"}, {"coarse_max_iters", "1.5"},
+                                       {"min_coarse_nodes", "-3"}, {"rediscretize", "2"}, {"embedding", "cubic"}};
+        for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
+            SolverOptions ob = {0};
+            set_opt(&ob, bad[k][0], bad[k][1]);
+            mpm_clear_error();
+            char want[96];
+            snprintf(want, sizeof want, "%s=%s", bad[k][0], bad[k][1]);
+            CHECK(inv_create(&inv_mg_ops, &ob, &V) == MPM_EINPUT && strstr(mpm_last_error(), want),
+                  "%s must be rejected naming key and value: '%s'", want, mpm_last_error());
+        }
         mpm_clear_error();
-        CHECK(inv_mg_linear_ops.create(NULL, &V) == MPM_OK, "create");
+        CHECK(inv_create(&inv_mg_ops, NULL, &V) == MPM_OK, "create");
         InvSetupInput in = setup_input(&p);
         in.H = NULL;
-        CHECK(V->ops->setup(V, &in) != MPM_OK && strstr(mpm_last_error(), "assembled matrix"), "matrix-free mg");
+        CHECK(inv_setup(V, &in) != MPM_OK && strstr(mpm_last_error(), "assembled matrix"), "matrix-free mg");
         mpm_clear_error();
-        MgInfo info;
-        CHECK(mg_get_info(V, &info) == MPM_OK, "info");
-        V->ops->destroy(V);
-        InvApprox *J = NULL;
-        inv_block_jacobi_ops.create(NULL, &J);
-        CHECK(mg_get_info(J, &info) == MPM_EINTERNAL, "mg_get_info on a non-mg");
-        mpm_clear_error();
-        J->ops->destroy(J);
+        InvView info;
+        inv_view(V, NULL, &info);
+        CHECK(info.n_levels == 0, "no hierarchy after a failed setup (%d levels)", info.n_levels);
+        inv_destroy(V);
     }
 
     /* one level = LBFGS-H's block-Jacobi PCG with the 1/2 rule; two sweeps */
@@ -389,17 +401,17 @@ int main(void)
         SolverOptions o = {0};
         set_opt(&o, "levels", "1");
         InvApprox *V = NULL;
-        inv_mg_linear_ops.create(&o, &V);
+        inv_create(&inv_mg_ops, &o, &V);
         InvSetupInput in = setup_input(&p);
-        st = V->ops->setup(V, &in);
-        st = st ? st : V->ops->apply(V, b, z);
+        st = inv_setup(V, &in);
+        st = st ? st : inv_apply(V, b, z);
         CHECK(st == MPM_OK && V->stats.inner_iters > 0, "one level: st %d inner %ld", st, V->stats.inner_iters);
         printf("levels=1 (LBFGS-H rule): %ld PCG iterations\n", V->stats.inner_iters);
-        V->ops->destroy(V);
+        inv_destroy(V);
         SolverOptions o2 = {0};
         set_opt(&o2, "sweeps", "2");
-        SolveStat s2 = pcg_with(&p, &inv_mg_linear_ops, &o2, b, z, 1e-8, 0);
-        SolveStat s1 = pcg_with(&p, &inv_mg_linear_ops, NULL, b, z, 1e-8, 0);
+        SolveStat s2 = pcg_with(&p, &inv_mg_ops, "linear", &o2, b, z, 1e-8, 0);
+        SolveStat s1 = pcg_with(&p, &inv_mg_ops, "linear", NULL, b, z, 1e-8, 0);
         printf("sweeps=2: %d PCG iterations (sweeps=1: %d)\n", s2.iters, s1.iters);
         CHECK(s2.iters <= s1.iters, "two sweeps should not need more iterations (%d vs %d)", s2.iters, s1.iters);
         free(b);

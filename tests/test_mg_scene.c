@@ -26,6 +26,9 @@
 #include "solvers/solver.h"
 #include "tests/testutil.h"
 
+static void spmv_op(const void *ctx, const double *x, double *y) { bsr_spmv((const Bsr *)ctx, x, y); }
+static void project_op(const void *ctx, double *v) { problem_project((const StepProblem *)ctx, v); }
+
 static double lambda_max_VH(const char *solver_name, const char *extra_opt)
 {
     Scene sc;
@@ -43,26 +46,26 @@ static double lambda_max_VH(const char *solver_name, const char *extra_opt)
     problem_energy(pb, dv);
     problem_tangent(pb, 1);
 
-    const SolverPreset *pre = registry_find(solver_name);
     const char *user[2] = {"coarse_tol=1e-6", extra_opt};
-    SolverOptions so;
-    registry_options(pre, user, extra_opt ? 2 : 1, &so);
     Solver *s = NULL;
+    Bsr H = {0};
+    double *diag = malloc(sizeof(double) * 9 * (size_t)n);
     double lambda = NAN;
-    if (solver_create(pre, &so, &s) || solver_reserve(s, n) || problem_assemble(pb, &s->H)) goto done;
-    LinearOp op;
-    Projection proj;
-    solver_hessian_op(s, pb, 1, &op);
-    solver_projection(pb, &proj);
-    if (solver_setup_inverse(s, pb, 1, &op, &proj)) goto done;
+    if (solver_from_spec(solver_name, user, extra_opt ? 2 : 1, &s) || problem_assemble(pb, &H)) goto done;
+    bsr_diagonal(&H, diag);
+    LinearOp op = {n, spmv_op, &H};
+    Projection proj = {project_op, pb};
+    InvSetupInput in = {.n_nodes = n, .H = &H, .diag = diag, .coord = pb->grid->coord,
+                        .coloring = &pb->grid->coloring, .op = &op, .proj = &proj, .problem = pb};
+    if (inv_setup(s->inv, &in)) goto done;
     CHECK(pb->n_dirichlet > 0, "wheel has sticky nodes (%d)", pb->n_dirichlet);
 
     unsigned long long rs = 11;
     for (size_t i = 0; i < len; ++i) x[i] = test_uniform(&rs, -1, 1);
     problem_project(pb, x);
     for (int it = 0; it < 15; ++it) {
-        bsr_spmv(&s->H, x, y);                 /* y = H x */
-        s->inv->ops->apply(s->inv, y, z);      /* z = V H x */
+        bsr_spmv(&H, x, y);                    /* y = H x */
+        inv_apply(s->inv, y, z);               /* z = V H x */
         problem_project(pb, z);
         /* Rayleigh quotient in the H inner product: x^T H (V H x) / x^T H x */
         double num = vec_dot(len, y, z), den = vec_dot(len, y, x);
@@ -72,6 +75,8 @@ static double lambda_max_VH(const char *solver_name, const char *extra_opt)
     }
 done:
     solver_destroy(s);
+    bsr_free(&H);
+    free(diag);
     free(dv), free(x), free(y), free(z);
     sim_free(&sim);
     scene_free(&sc);

@@ -18,11 +18,11 @@
 static InvApprox *make_inv(const InvApproxOps *ops, const SynthProblem *p)
 {
     InvApprox *M = NULL;
-    int st = ops->create(NULL, &M);
+    int st = inv_create(ops, NULL, &M);
     CHECK(st == MPM_OK, "%s create: %s", ops->name, mpm_last_error());
     InvSetupInput in = {.n_nodes = p->n, .H = &p->A, .diag = p->diag, .coord = p->coord, .coloring = &p->col,
                         .op = &p->op, .proj = &p->proj};
-    st = ops->setup(M, &in);
+    st = inv_setup(M, &in);
     CHECK(st == MPM_OK, "%s setup: %s", ops->name, mpm_last_error());
     return M;
 }
@@ -192,13 +192,13 @@ int main(void)
         PcgOptions o = {.stop = PCG_FORCING, .tau = 1e-5, .max_iters = 10000};
         st = pcg_solve(&q.op, bq_j, NULL, bq, xq, &o, &work, &res);
         CHECK(st == MPM_OK && work.cap_nodes >= q.n && !res.capped, "grown work: st %d cap %d", st, work.cap_nodes);
-        bq_j->ops->destroy(bq_j);
+        inv_destroy(bq_j);
         free(bq);
         free(xq);
         synth_free(&q);
     }
 
-    /* 7. singular diagonal block -> MPM_EINTERNAL naming the node */
+    /* 7. singular diagonal block -> MPM_ENUMERIC (a breakdown of the step) naming the node */
     {
         double *d = malloc(sizeof(double) * 9 * (size_t)p.n);
         memcpy(d, p.diag, sizeof(double) * 9 * (size_t)p.n);
@@ -206,19 +206,19 @@ int main(void)
         d[9 * 17] = 1.0;
         d[9 * 17 + 4] = 1.0; /* rank 2 */
         InvApprox *M = NULL;
-        inv_block_jacobi_ops.create(NULL, &M);
+        inv_create(&inv_block_jacobi_ops, NULL, &M);
         InvSetupInput in = {.n_nodes = p.n, .diag = d};
         mpm_clear_error();
-        st = M->ops->setup(M, &in);
-        CHECK(st == MPM_EINTERNAL && strstr(mpm_last_error(), "node 17"), "singular block: st %d msg '%s'", st,
+        st = inv_setup(M, &in);
+        CHECK(st == MPM_ENUMERIC && strstr(mpm_last_error(), "node 17"), "singular block: st %d msg '%s'", st,
               mpm_last_error());
-        M->ops->destroy(M);
-        inv_scalar_jacobi_ops.create(NULL, &M);
+        inv_destroy(M);
+        inv_create(&inv_scalar_jacobi_ops, NULL, &M);
         mpm_clear_error();
-        st = M->ops->setup(M, &in);
-        CHECK(st == MPM_EINTERNAL && strstr(mpm_last_error(), "node 17"), "zero diagonal entry: st %d msg '%s'", st,
+        st = inv_setup(M, &in);
+        CHECK(st == MPM_ENUMERIC && strstr(mpm_last_error(), "node 17"), "zero diagonal entry: st %d msg '%s'", st,
               mpm_last_error());
-        M->ops->destroy(M);
+        inv_destroy(M);
         mpm_clear_error();
         free(d);
     }
@@ -237,7 +237,7 @@ int main(void)
         double *bq = malloc(sizeof(double) * lq), *xq = malloc(sizeof(double) * lq);
         synth_random_vector(q.n, 11, bq);
         InvApprox *inner = make_inv(&inv_inexact_pcg_ops, &q);
-        CHECK(inner->variable == 1, "the inexact PCG must declare itself variable");
+        CHECK(inner->flexible == 1, "the inexact PCG must declare itself variable");
         InvApprox *fixed = make_inv(&inv_block_jacobi_ops, &q);
         PcgOptions o = {.stop = PCG_ABSOLUTE, .abs_tol = 0.0, .max_iters = 0};
         pcg_solve(&q.op, fixed, &q.proj, bq, xq, &o, &work, &res);
@@ -248,9 +248,9 @@ int main(void)
         InvApprox *pre[2] = {fixed, inner};
         for (int v = 0; v < 2; ++v) {
             for (int f = 0; f < 2; ++f) {
-                pre[v]->variable = f;
+                pre[v]->flexible = f;
                 if (v == 1) { /* same tolerance in the same (block-Jacobi) norm scale */
-                    pcg_solve(&q.op, inner, &q.proj, bq, xq, &(PcgOptions){PCG_ABSOLUTE, 0, 0, 0}, &work, &res);
+                    pcg_solve(&q.op, inner, &q.proj, bq, xq, &(PcgOptions){PCG_ABSOLUTE, 0, 0, 0, 0}, &work, &res);
                     o.abs_tol = 1e-10 * res.rho0;
                 }
                 st = pcg_solve(&q.op, pre[v], &q.proj, bq, xq, &o, &work, &res);
@@ -268,15 +268,15 @@ int main(void)
         CHECK(rr[0][1] < 1e-8 && rr[1][1] < 1e-8, "flexible CG residuals %g %g", rr[0][1], rr[1][1]);
         CHECK(2 * iters[1][1] < iters[1][0], "variable preconditioner: flexible %d vs plain %d iterations",
               iters[1][1], iters[1][0]);
-        inner->ops->destroy(inner);
-        fixed->ops->destroy(fixed);
+        inv_destroy(inner);
+        inv_destroy(fixed);
         free(bq);
         free(xq);
         synth_free(&q);
     }
 
-    bj->ops->destroy(bj);
-    sj->ops->destroy(sj);
+    inv_destroy(bj);
+    inv_destroy(sj);
     pcg_work_free(&work);
     free(b);
     free(x);

@@ -140,10 +140,10 @@ int main(void)
         InvSetupInput in = {.n_nodes = n, .H = &p.A, .diag = p.diag, .coord = p.coord, .coloring = &p.col,
                             .op = &p.op, .proj = &p.proj};
         InvApprox *S = NULL, *J = NULL;
-        CHECK(inv_sgs_ops.create(NULL, &S) == MPM_OK, "sgs create");
-        CHECK(inv_sgs_ops.setup(S, &in) == MPM_OK, "sgs setup: %s", mpm_last_error());
-        inv_block_jacobi_ops.create(NULL, &J);
-        inv_block_jacobi_ops.setup(J, &in);
+        CHECK(inv_create(&inv_sgs_ops, NULL, &S) == MPM_OK, "sgs create");
+        CHECK(inv_setup(S, &in) == MPM_OK, "sgs setup: %s", mpm_last_error());
+        inv_create(&inv_block_jacobi_ops, NULL, &J);
+        inv_setup(J, &in);
         synth_random_vector(n, 11, y);
         PcgWork w = {0};
         PcgResult rs, rj;
@@ -171,12 +171,12 @@ int main(void)
         InvSetupInput mf = in;
         mf.H = NULL;
         mpm_clear_error();
-        st = inv_sgs_ops.setup(S, &mf);
+        st = inv_setup(S, &mf);
         CHECK(st != MPM_OK && strstr(mpm_last_error(), "assembled matrix"), "matrix-free sgs must fail: '%s'",
               mpm_last_error());
         mpm_clear_error();
-        S->ops->destroy(S);
-        J->ops->destroy(J);
+        inv_destroy(S);
+        inv_destroy(J);
     }
 
     /* the colouring check catches a too-wide stencil */

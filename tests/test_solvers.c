@@ -1,47 +1,81 @@
-/* Solver conformance on the same step problem (SPEC 4, 5, 7):
- *  - every registered solver reaches the CN tolerance eps = 1e-7 on the first
- *    step of `stretched-box`, and PN solvers lower E monotonically;
- *  - all of them reach the same dv within a bound implied by the tolerance;
- *  - the same solver twice with the same thread count gives identical
- *    iteration counts and residuals (determinism);
- *  - HOT needs far fewer L-BFGS iterations than LBFGS-H on the stretched box
- *    (HOT Fig. 18: 25 vs 106 at paper size; we assert a ratio >= 3).
+/* Solver agreement on one step problem (SPEC 4, 5, 7, 11): every registered
+ * preset on the first step of `twist` at scale 5.2 (1,372 active nodes, a
+ * soft bar twisted between stiff ends: tens of Newton and about a hundred
+ * L-BFGS iterations).
  *
- * Agreement bound, in the energy norm |e|_H = sqrt(e^T H e) of the projected
- * Hessian H at the reference solution (pn-pcg's): for the quadratic model,
- * an iterate with gradient g lies at |dv - dv*|_H = |g|_{H^-1} from the
- * minimiser. The CN rule s < eps means g = K u with K = diag(kappa_i) and
- * |u|_2 < sqrt(n) eps, so |g|_{H^-1} < sqrt(n) eps sqrt(lambda_max(K H^-1 K))
- * (lambda_max by power iteration with accurate PCG solves). Two converged
- * solvers therefore differ by at most 2 sqrt(n) eps sqrt(lambda_max) in the
- * H-norm; the test allows a factor 1.5 on top for the non-quadratic part of
- * E between the iterates. That worst case is loose where stiff material has
- * light nodes (the CN rule then admits large gradients there), so a second,
- * a-posteriori check uses each solver's actual gradient:
- * |dv_k - dv_0|_H <= 1.5 (|g(dv_k)|_{H^-1} + |g(dv_0)|_{H^-1}). */
+ *  - each preset returns MPM_OK with status converged at eps = 1e-7, its
+ *    reported residual is the CN residual of the dv it returns (recomputed
+ *    here), and no iteration raises the energy;
+ *  - agreement, a posteriori and two-sided, at eps = 1e-9 (tight enough
+ *    for the local model to hold between the iterates): against a tight
+ *    reference dv* (pn-cholmod at eps = 1e-13), in the energy norm
+ *    |e|_H = sqrt(e^T H e) of the BC-projected true (unprojected) Hessian H
+ *    at dv* (SPD at a minimiser), g(dv_k) - g(dv*) = Hbar (dv_k - dv*) with
+ *    Hbar the Hessian averaged over the segment. As long as the curvature
+ *    along it stays within a factor 2 of H's, r_k = |g(dv_k)|_{H^-1} (one
+ *    CHOLMOD solve) brackets the distance:
+ *        r_k / 2 - r* <= |dv_k - dv*|_H <= 2 r_k + r*,   r* = |g(dv*)|_{H^-1}
+ *    (observed ratios 0.99-1.03, one 1.47). A solver that moves Dirichlet
+ *    values, minimises another energy or returns an iterate other than the
+ *    one it judged breaks it. (The a-priori bound of the old test from the
+ *    CN rule, |g|_{H^-1} <= sqrt(n) eps sqrt(lambda_max(K H^-1 K)), was 1e8
+ *    times the observed difference on stiff scenes and is not used.)
+ *  - the same solver twice gives identical iteration counts and a bitwise
+ *    identical residual (determinism at a fixed thread count).
+ * HOT against LBFGS-H (HOT Fig. 18) is tests/test_solvers_hot.c. */
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/error.h"
 #include "core/step.h"
 #include "core/vec.h"
 #include "experiments/registry.h"
-#include "solvers/jacobi.h"
-#include "solvers/pcg.h"
 #include "tests/testutil.h"
+
+#define SCENE "twist"
+#define SCALE 5.2
+#define EPS 1e-9      /* tight enough that the quadratic model holds between iterates */
+#define EPS_REF 1e-13 /* the reference */
 
 typedef struct {
     double last;
     int monotone;
-    int iters;
 } EnergyTrace;
 
 static void trace_hook(void *ctx, int iter, double elapsed, double residual, double energy)
 {
+    (void)elapsed;
+    (void)residual;
     EnergyTrace *t = ctx;
     if (iter > 0 && energy > t->last) t->monotone = 0;
     t->last = energy;
-    t->iters = iter;
+}
+
+typedef struct {
+    Scene sc;
+    Simulation sim;
+    int loaded, started;
+} Step;
+
+/* The first step problem of the scene, ready for a solve. */
+static int step_open(Step *s)
+{
+    memset(s, 0, sizeof *s);
+    SceneLoadOptions lo = {SCALE, NULL, 0, NULL};
+    int st = scene_load(SCENE, &lo, &s->sc);
+    if (st) return st;
+    s->loaded = 1;
+    if ((st = sim_init(&s->sim, &s->sc))) return st;
+    s->started = 1;
+    return step_begin(&s->sim);
+}
+
+static void step_close(Step *s)
+{
+    if (s->started) sim_free(&s->sim);
+    if (s->loaded) scene_free(&s->sc);
 }
 
 typedef struct {
@@ -50,161 +84,141 @@ typedef struct {
     int monotone;
 } Outcome;
 
-static int solve_first_step(const char *scene_name, const SceneOverride *ov, int n_ov, double scale,
-                            const char *solver, Outcome *out)
+/* Solves the first step with `spec` at eps; MPM_OK or the failing status
+ * (every call checked). */
+static int solve_first_step(const char *spec, double eps, Outcome *out)
 {
-    Scene sc;
-    SceneLoadOptions lo = {scale, ov, n_ov, NULL};
-    if (scene_load(scene_name, &lo, &sc)) return 1;
-    Simulation sim;
-    sim_init(&sim, &sc);
-    step_begin(&sim);
-    int n = sim.pb.n_nodes;
-    out->dv = calloc(3 * (size_t)n, sizeof(double));
-    problem_initial_guess(&sim.pb, out->dv);
-    const SolverPreset *pre = registry_find(solver);
-    SolverOptions so;
-    registry_options(pre, NULL, 0, &so);
-    Solver *s = NULL;
-    solver_create(pre, &so, &s);
-    SolveSettings set;
-    solve_settings_default(&set);
-    EnergyTrace tr = {0, 1, 0};
-    int st = solver_solve(s, &sim.pb, &set, out->dv, &out->st, trace_hook, &tr);
-    out->monotone = tr.monotone;
-    solver_destroy(s);
-    sim_free(&sim);
-    scene_free(&sc);
+    memset(out, 0, sizeof *out);
+    Step s;
+    Solver *solver = NULL;
+    int st = step_open(&s);
+    if (!st) st = solver_from_spec(spec, NULL, 0, &solver);
+    if (!st) {
+        int n = s.sim.pb.n_nodes;
+        out->dv = calloc(3 * (size_t)n, sizeof(double));
+        if (!out->dv) st = MPM_EINTERNAL;
+    }
+    if (!st) {
+        problem_initial_guess(&s.sim.pb, out->dv);
+        SolveSettings set;
+        solve_settings_default(&set);
+        set.eps = eps;
+        EnergyTrace tr = {0, 1};
+        st = solver_solve(solver, &s.sim.pb, &set, out->dv, &out->st, trace_hook, &tr);
+        out->monotone = tr.monotone;
+    }
+    if (st) fprintf(stderr, "%s: %s\n", spec, mpm_last_error());
+    solver_destroy(solver);
+    step_close(&s);
     return st;
 }
 
 static void spmv_op(const void *ctx, const double *x, double *y) { bsr_spmv((const Bsr *)ctx, x, y); }
 static void project_op(const void *ctx, double *v) { problem_project((const StepProblem *)ctx, v); }
 
-/* H-norm differences |dv_k - dv_0|_H and the tolerance bound (see the top). */
-static double energy_norm_check(const char *scene, const SceneOverride *ov, int n_ov, double scale,
-                                Outcome *res, int np, double *diff, double *gnorm)
+/* For dv_k (k < np) with the reference dv* = res[0].dv: e[k] = |dv_k - dv*|_H,
+ * r[k] = |g(dv_k)|_{H^-1} and the CN residual cn[k] of g(dv_k). */
+static int measure(Outcome *res, int np, double *e, double *r, double *cn)
 {
-    Scene sc;
-    SceneLoadOptions lo = {scale, ov, n_ov, NULL};
-    if (scene_load(scene, &lo, &sc)) return 0;
-    Simulation sim;
-    sim_init(&sim, &sc);
-    step_begin(&sim);
-    StepProblem *pb = &sim.pb;
-    int n = pb->n_nodes;
-    size_t len = 3 * (size_t)n;
-    problem_energy(pb, res[0].dv);
-    problem_tangent(pb, 1);
-    Bsr H = {0};
-    problem_assemble(pb, &H);
-    double *D = malloc(sizeof(double) * 9 * (size_t)n), *v = malloc(sizeof(double) * len),
-           *w = malloc(sizeof(double) * len), *y = malloc(sizeof(double) * len), *z = malloc(sizeof(double) * len);
-    bsr_diagonal(&H, D);
-    LinearOp op = {n, spmv_op, &H};
-    Projection proj = {project_op, pb};
-    InvApprox *jac = NULL;
-    inv_block_jacobi_ops.create(NULL, &jac);
-    InvSetupInput in = {.n_nodes = n, .H = &H, .diag = D, .op = &op, .proj = &proj};
-    jac->ops->setup(jac, &in);
-    PcgWork work = {0};
-    unsigned long long rs = 5;
-    for (size_t i = 0; i < len; ++i) v[i] = test_uniform(&rs, -1, 1);
-    double lambda = 0;
-    for (int it = 0; it < 20; ++it) {
-        for (size_t i = 0; i < len; ++i) w[i] = pb->kappa[i / 3] * v[i];
-        problem_project(pb, w);
-        jac->ops->apply(jac, w, z);
-        PcgOptions po = {PCG_ABSOLUTE, 0, 1e-9 * sqrt(vec_dot(len, w, z)), 20000};
-        PcgResult pr;
-        pcg_solve(&op, jac, &proj, w, y, &po, &work, &pr);
-        for (size_t i = 0; i < len; ++i) z[i] = pb->kappa[i / 3] * y[i];
-        problem_project(pb, z);
-        lambda = vec_dot(len, v, z) / vec_dot(len, v, v);
-        double nz = vec_norm(len, z);
-        for (size_t i = 0; i < len; ++i) v[i] = z[i] / nz;
+    Step s;
+    int st = step_open(&s);
+    if (st) {
+        step_close(&s);
+        return st;
     }
-    for (int k = 1; k < np; ++k) {
+    StepProblem *pb = &s.sim.pb;
+    const int n = pb->n_nodes;
+    const size_t len = 3 * (size_t)n;
+    Bsr H = {0};
+    InvApprox *chol = NULL;
+    double *D = malloc(sizeof(double) * 9 * (size_t)n), *w = malloc(sizeof(double) * len),
+           *y = malloc(sizeof(double) * len);
+    problem_energy(pb, res[0].dv);
+    if (!D || !w || !y) st = MPM_EINTERNAL;
+    /* the true (unprojected) Hessian: dv* is a minimiser, so it is SPD there,
+     * and the quadratic model holds with it */
+    if (!st) st = problem_tangent(pb, 0);
+    if (!st) st = problem_assemble(pb, &H);
+    if (!st) st = inv_create(registry_find_inverse("cholmod"), NULL, &chol);
+    if (!st) {
+        bsr_diagonal(&H, D);
+        LinearOp op = {n, spmv_op, &H};
+        Projection proj = {project_op, pb};
+        InvSetupInput in = {.n_nodes = n, .H = &H, .diag = D, .op = &op, .proj = &proj};
+        st = inv_setup(chol, &in);
+    }
+    for (int k = 0; k < np && !st; ++k) {
         for (size_t i = 0; i < len; ++i) w[i] = res[k].dv[i] - res[0].dv[i];
         bsr_spmv(&H, w, y);
-        diff[k] = sqrt(fmax(vec_dot(len, w, y), 0.0));
-    }
-    /* |g(dv_k)|_{H^-1}: the actual distance of each iterate from the minimiser */
-    for (int k = 0; k < np; ++k) {
+        e[k] = sqrt(fmax(vec_dot(len, w, y), 0.0));
         problem_energy(pb, res[k].dv);
         problem_gradient(pb, res[k].dv, w);
-        jac->ops->apply(jac, w, z);
-        double r0 = sqrt(fmax(vec_dot(len, w, z), 0.0));
-        PcgOptions po = {PCG_ABSOLUTE, 0, 1e-11 * r0, 20000};
-        PcgResult pr;
-        pcg_solve(&op, jac, &proj, w, y, &po, &work, &pr);
-        gnorm[k] = sqrt(fmax(vec_dot(len, w, y), 0.0));
+        cn[k] = problem_cn_residual(pb, w);
+        st = inv_apply(chol, w, y);
+        r[k] = sqrt(fmax(vec_dot(len, w, y), 0.0));
     }
-    double bound = 2.0 * sqrt((double)n) * 1e-7 * sqrt(lambda);
-    jac->ops->destroy(jac);
-    pcg_work_free(&work);
-    free(D), free(v), free(w), free(y), free(z);
+    inv_destroy(chol);
     bsr_free(&H);
-    sim_free(&sim);
-    scene_free(&sc);
-    return bound;
+    free(D), free(w), free(y);
+    step_close(&s);
+    return st;
 }
 
-static void agreement(const char *scene, const SceneOverride *ov, int n_ov, double scale)
+static void agreement(void)
 {
-    int np = registry_count();
+    const int np = registry_preset_count() + 1; /* [0] = the reference */
     Outcome *res = calloc((size_t)np, sizeof(Outcome));
-    for (int k = 0; k < np; ++k) {
-        const SolverPreset *p = registry_get(k);
-        int st = solve_first_step(scene, ov, n_ov, scale, p->name, &res[k]);
-        CHECK(st == 0, "%s on %s: solve returned %d", p->name, scene, st);
-        CHECK(res[k].st.status == SOLVE_CONVERGED, "%s on %s: status %s, residual %.3e", p->name, scene,
-              solve_status_name(res[k].st.status), res[k].st.residual);
-        CHECK(res[k].st.residual < 1e-7, "%s on %s: residual %.3e < 1e-7", p->name, scene, res[k].st.residual);
-        if (p->method == METHOD_PN) CHECK(res[k].monotone, "%s on %s: energy decreases monotonically", p->name, scene);
-        printf("%-14s %-14s outer %4d linear %6ld residual %.3e\n", scene, p->name, res[k].st.outer_iters,
-               res[k].st.linear_iters, res[k].st.residual);
-    }
-    double *diff = calloc((size_t)np, sizeof(double)), *gnorm = calloc((size_t)np, sizeof(double));
-    double bound = energy_norm_check(scene, ov, n_ov, scale, res, np, diff, gnorm);
-    CHECK(bound > 0, "%s: bound computed", scene);
+    int st = solve_first_step("pn-cholmod", EPS_REF, &res[0]);
+    CHECK(st == MPM_OK && res[0].st.status == SOLVE_CONVERGED, "reference pn-cholmod at eps %g: status %d, %s", EPS_REF, st,
+          solve_status_name(res[0].st.status));
+    if (st) return;
     for (int k = 1; k < np; ++k) {
-        double post = gnorm[k] + gnorm[0];
-        CHECK(diff[k] <= 1.5 * bound, "%s vs %s on %s: |dv difference|_H %.3e > 1.5 x bound %.3e",
-              registry_get(k)->name, registry_get(0)->name, scene, diff[k], bound);
-        CHECK(diff[k] <= 1.5 * post, "%s vs %s on %s: |dv difference|_H %.3e > 1.5 x a-posteriori bound %.3e",
-              registry_get(k)->name, registry_get(0)->name, scene, diff[k], post);
-        printf("  %s vs %s: |ddv|_H = %.3e (a-posteriori bound %.3e, tolerance bound %.3e)\n", registry_get(k)->name,
-               registry_get(0)->name, diff[k], post, bound);
+        const char *name = registry_preset(k - 1)->name;
+        double t0 = omp_get_wtime();
+        st = solve_first_step(name, EPS, &res[k]);
+        double t1 = omp_get_wtime();
+        CHECK(st == MPM_OK, "%s: solve returned %d", name, st);
+        if (st) return;
+        CHECK(res[k].st.status == SOLVE_CONVERGED, "%s: status %s (%s), residual %.3e", name,
+              solve_status_name(res[k].st.status), res[k].st.reason, res[k].st.residual);
+        CHECK(res[k].monotone, "%s: an accepted iterate raised the energy", name);
+        printf("%-14s outer %4d linear %6ld inner %6ld residual %.3e (%.2f s)\n", name, res[k].st.outer_iters,
+               res[k].st.linear_iters, res[k].st.inner_iters, res[k].st.residual, t1 - t0);
+    }
+    /* the step is a hard one: tens of Newton iterations for the Jacobi PCG preset */
+    CHECK(res[1].st.outer_iters >= 10, "%s needs %d outer iterations: pick a harder step", registry_preset(0)->name,
+          res[1].st.outer_iters);
+    double *e = calloc((size_t)np, sizeof(double)), *r = calloc((size_t)np, sizeof(double)),
+           *cn = calloc((size_t)np, sizeof(double));
+    st = measure(res, np, e, r, cn);
+    CHECK(st == MPM_OK, "energy norms: %s", mpm_last_error());
+    for (int k = 1; k < np; ++k)
+        CHECK(r[0] < 0.05 * r[k], "the reference is tight: |g*|_H^-1 %.3e vs %.3e of %s", r[0], r[k],
+              registry_preset(k - 1)->name);
+    for (int k = 1; k < np && !st; ++k) {
+        const char *name = registry_preset(k - 1)->name;
+        CHECK(cn[k] < EPS && fabs(cn[k] - res[k].st.residual) <= 1e-12 * cn[k],
+              "%s: CN residual at the returned dv %.6e, reported %.6e", name, cn[k], res[k].st.residual);
+        CHECK(e[k] <= 2.0 * r[k] + r[0] && e[k] >= 0.5 * r[k] - r[0],
+              "%s: |dv - dv*|_H %.4e outside [%.4e, %.4e] (|g|_H^-1 %.4e)", name, e[k], 0.5 * r[k] - r[0],
+              2.0 * r[k] + r[0], r[k]);
+        printf("  %-14s |dv - dv*|_H = %.4e, |g(dv)|_H^-1 = %.4e (ratio %.4f)\n", name, e[k], r[k], e[k] / r[k]);
     }
     for (int k = 0; k < np; ++k) free(res[k].dv);
-    free(res);
-    free(diff);
-    free(gnorm);
+    free(res), free(e), free(r), free(cn);
 }
 
-static void hot_vs_lbfgs_h(void)
-{
-    Outcome h, l;
-    solve_first_step("stretched-box", NULL, 0, 1.4, "hot", &h);
-    solve_first_step("stretched-box", NULL, 0, 1.4, "lbfgs-h", &l);
-    printf("stretched-box scale 1.4: hot %d outer, lbfgs-h %d outer\n", h.st.outer_iters, l.st.outer_iters);
-    CHECK(h.st.status == SOLVE_CONVERGED && l.st.status == SOLVE_CONVERGED, "both converge");
-    CHECK(l.st.outer_iters >= 3 * h.st.outer_iters, "HOT %d vs LBFGS-H %d outer iterations: ratio below 3",
-          h.st.outer_iters, l.st.outer_iters);
-    free(h.dv);
-    free(l.dv);
-}
-
-static void determinism(void)
+static void determinism(const char *spec)
 {
     Outcome a, b;
-    solve_first_step("stretched-box", NULL, 0, 2.0, "pn-pcg", &a);
-    solve_first_step("stretched-box", NULL, 0, 2.0, "pn-pcg", &b);
-    CHECK(a.st.outer_iters == b.st.outer_iters && a.st.linear_iters == b.st.linear_iters,
-          "same iteration counts twice (%d/%ld vs %d/%ld)", a.st.outer_iters, a.st.linear_iters, b.st.outer_iters,
-          b.st.linear_iters);
-    CHECK(a.st.residual == b.st.residual, "bitwise identical residual twice (%.17g vs %.17g)", a.st.residual,
+    int st = solve_first_step(spec, 1e-7, &a);
+    st |= solve_first_step(spec, 1e-7, &b);
+    CHECK(st == MPM_OK, "%s twice: %d", spec, st);
+    CHECK(a.st.outer_iters == b.st.outer_iters && a.st.linear_iters == b.st.linear_iters &&
+              a.st.inner_iters == b.st.inner_iters,
+          "%s: same iteration counts twice (%d/%ld/%ld vs %d/%ld/%ld)", spec, a.st.outer_iters, a.st.linear_iters,
+          a.st.inner_iters, b.st.outer_iters, b.st.linear_iters, b.st.inner_iters);
+    CHECK(a.st.residual == b.st.residual, "%s: bitwise identical residual twice (%.17g vs %.17g)", spec, a.st.residual,
           b.st.residual);
     free(a.dv);
     free(b.dv);
@@ -212,10 +226,8 @@ static void determinism(void)
 
 int main(void)
 {
-    agreement("stretched-box", NULL, 0, 2.0);
-    SceneOverride stiff = {"materials.middle.E", "1e9"};
-    agreement("bar3", &stiff, 1, 4.0);
-    determinism();
-    hot_vs_lbfgs_h();
+    agreement();
+    determinism("pn-pcg");
+    determinism("hot");
     return test_summary("test_solvers");
 }

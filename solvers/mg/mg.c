@@ -16,6 +16,23 @@
 #include "solvers/pcg.h"
 #include "solvers/sgs.h"
 
+/* What the view op reports: the hierarchy of the last setup and the work
+ * done by V-cycles since. */
+typedef struct {
+    int n_levels;
+    int embedding;                     /* MgEmbedding */
+    int rediscretized;                 /* baseline GMG */
+    int n[MG_MAX_LEVELS];              /* nodes per level */
+    int64_t nnzb[MG_MAX_LEVELS];       /* stored blocks per level */
+    double avg_row[MG_MAX_LEVELS];     /* nonzero blocks per row, mean */
+    int max_row[MG_MAX_LEVELS];        /* and max */
+    double setup_s;                    /* whole setup (last call) */
+    double transfer_s, galerkin_s, diag_s; /* parts of it */
+    long vcycles, coarse_iters, coarse_capped; /* since the last setup */
+    double smooth_s[MG_MAX_LEVELS];    /* apply time split, since the last setup */
+    double transfer_apply_s, coarse_s;
+} MgInfo;
+
 typedef struct {
     int n;
     const Bsr *A;          /* level 0: the input H; else &Aown */
@@ -60,7 +77,8 @@ static int cj_apply(InvApprox *self, const double *r, double *z)
     vec_block_apply((size_t)c->n, c->dinv, r, z);
     return MPM_OK;
 }
-static const InvApproxOps coarse_jacobi_ops = {"mg-coarse-jacobi", NULL, NULL, cj_apply, NULL};
+static const InvApproxOps coarse_jacobi_ops = {"mg-coarse-jacobi", "the coarsest level's block Jacobi", NULL, NULL,
+                                               cj_apply, NULL, NULL};
 
 static void level_spmv(const void *ctx, const double *x, double *y) { bsr_spmv((const Bsr *)ctx, x, y); }
 
@@ -84,61 +102,50 @@ static int level_reserve(MgLevel *L, int n, int own_diag)
     return MPM_OK;
 }
 
-static int mg_create(MgEmbedding kind, int rediscretize, SolverOptions *opt, InvApprox **out)
+static int mg_create(SolverOptions *opt, InvApprox **out)
 {
     int st = MPM_OK;
-    double levels = solver_opt_number(opt, "levels", 3, &st);
-    double sweeps = solver_opt_number(opt, "sweeps", 1, &st);
-    double minc = solver_opt_number(opt, "min_coarse_nodes", 300, &st);
+    int rediscretize = solver_opt_int(opt, "rediscretize", 0, 0, 1, &st);
+    int levels = solver_opt_int(opt, "levels", 3, 1, MG_MAX_LEVELS, &st);
+    int sweeps = solver_opt_int(opt, "sweeps", 1, 1, 100, &st);
+    int minc = solver_opt_int(opt, "min_coarse_nodes", 300, 1, 1000000000, &st);
     double ctol = solver_opt_number(opt, "coarse_tol", 0.5, &st);
-    double cmax = solver_opt_number(opt, "coarse_max_iters", 10000, &st);
-    double exact = solver_opt_number(opt, "coarse_exact", 0, &st);
-    double flexible = solver_opt_number(opt, "flexible", 1, &st);
-    double bc_project = rediscretize ? solver_opt_number(opt, "coarse_bc_project", 1, &st) : 0;
-    if (st) return st;
-    if (!rediscretize) { /* the Galerkin hierarchy's embedding kernel (SPEC 6) */
-        const char *emb = solver_opt_string(opt, "embedding", kind == MG_EMBED_LINEAR ? "linear" : "quadratic");
-        if (!strcmp(emb, "linear")) kind = MG_EMBED_LINEAR;
-        else if (!strcmp(emb, "quadratic")) kind = MG_EMBED_QUADRATIC;
-        else return mpm_error(MPM_EINPUT, "--solver-opt embedding=%s: expected linear or quadratic", emb);
+    int cmax = solver_opt_int(opt, "coarse_max_iters", 10000, 1, 1000000000, &st);
+    int exact = solver_opt_int(opt, "coarse_exact", 0, 0, 1, &st);
+    int flexible = solver_opt_int(opt, "flexible", 1, 0, 1, &st);
+    /* only where it applies, so that a misplaced option is reported as unknown */
+    int bc_project = rediscretize ? solver_opt_int(opt, "coarse_bc_project", 1, 0, 1, &st) : 0;
+    MgEmbedding kind = MG_EMBED_LINEAR;
+    if (!st && !rediscretize) { /* the Galerkin hierarchy's embedding kernel (SPEC 6) */
+        const char *emb = solver_opt_string(opt, "embedding", "linear");
+        if (!strcmp(emb, "quadratic")) kind = MG_EMBED_QUADRATIC;
+        else if (strcmp(emb, "linear") != 0)
+            st = mpm_error(MPM_EINPUT, "solver option embedding=%s: expected linear or quadratic", emb);
     }
-    if (!(levels >= 1 && levels <= MG_MAX_LEVELS && levels == floor(levels)))
-        return mpm_error(MPM_EINPUT, "--solver-opt levels=%g: expected an integer in [1, %d]", levels, MG_MAX_LEVELS);
-    if (!(sweeps >= 1 && sweeps <= 100 && sweeps == floor(sweeps)))
-        return mpm_error(MPM_EINPUT, "--solver-opt sweeps=%g: expected an integer in [1, 100]", sweeps);
-    if (!(minc >= 1 && minc <= 1e9))
-        return mpm_error(MPM_EINPUT, "--solver-opt min_coarse_nodes=%g: expected a positive integer", minc);
-    if (!(ctol > 0 && ctol < 1)) return mpm_error(MPM_EINPUT, "--solver-opt coarse_tol=%g: expected 0 < tol < 1", ctol);
-    if (!(cmax >= 1 && cmax <= 1e9))
-        return mpm_error(MPM_EINPUT, "--solver-opt coarse_max_iters=%g: expected a positive integer", cmax);
+    if (st) return st;
+    if (!(ctol > 0 && ctol < 1)) return mpm_error(MPM_EINPUT, "solver option coarse_tol=%g: expected 0 < tol < 1", ctol);
     Mg *M = calloc(1, sizeof *M);
     if (!M) return mpm_error(MPM_EINTERNAL, "out of memory: multigrid");
-    M->base.ops = rediscretize ? &inv_gmg_ops : kind == MG_EMBED_LINEAR ? &inv_mg_linear_ops : &inv_mg_quadratic_ops;
+    M->base.ops = &inv_mg_ops;
     M->kind = kind;
     M->rediscretize = rediscretize;
-    M->gmg_bc_project = bc_project != 0;
-    M->max_levels = (int)levels;
-    M->sweeps = (int)sweeps;
-    M->min_coarse = (int)minc;
-    M->coarse_tol = exact != 0 ? 1e-12 : ctol;
-    M->coarse_max_iters = (int)cmax;
+    M->gmg_bc_project = bc_project;
+    M->max_levels = levels;
+    M->sweeps = sweeps;
+    M->min_coarse = minc;
+    M->coarse_tol = exact ? 1e-12 : ctol;
+    M->coarse_max_iters = cmax;
     M->cj.base.ops = &coarse_jacobi_ops;
-    /* the adaptive coarsest PCG makes the V-cycle vary with its input: outer
-     * PCG uses flexible CG unless flexible=0 (the reference's plain PCG) */
-    M->base.variable = flexible != 0 && levels > 1;
+    M->cj.base.ready = 1; /* shares the level's D^-1, set up with the hierarchy */
+    /* the adaptive coarsest PCG makes the V-cycle vary with its input (to
+     * 1e-12 with coarse_exact=1: then symmetric, as tests/test_mg.c checks);
+     * outer PCG uses flexible CG unless flexible=0 (the reference's plain PCG) */
+    M->base.caps = INV_NEEDS_MATRIX | INV_POSITIVE | INV_INNER_ITERS | (rediscretize ? INV_NEEDS_PROBLEM : 0u) |
+                   (exact ? INV_SYMMETRIC : INV_VARIABLE);
+    M->base.flexible = flexible && levels > 1;
     *out = &M->base;
     return MPM_OK;
 }
-
-static int mg_linear_create(SolverOptions *opt, InvApprox **out)
-{
-    return mg_create(MG_EMBED_LINEAR, 0, opt, out);
-}
-static int mg_quadratic_create(SolverOptions *opt, InvApprox **out)
-{
-    return mg_create(MG_EMBED_QUADRATIC, 0, opt, out);
-}
-static int gmg_create(SolverOptions *opt, InvApprox **out) { return mg_create(MG_EMBED_LINEAR, 1, opt, out); }
 
 static void fill_level_info(Mg *M, int l)
 {
@@ -266,6 +273,7 @@ static int mg_apply(InvApprox *self, const double *in, double *out)
     PcgResult res;
     int st;
 
+
     /* tolerance of the coarse solve from the input restricted straight down
      * (reference §5.3): coarse_tol * sqrt(bbar^T D^-1 bbar) */
     double t0 = omp_get_wtime();
@@ -280,40 +288,38 @@ static int mg_apply(InvApprox *self, const double *in, double *out)
                      .max_iters = M->coarse_max_iters};
     M->info.transfer_apply_s += omp_get_wtime() - t0;
 
-    if (nl == 1) { /* LBFGS-H: block-Jacobi PCG on the fine level */
-        LinearOp op = {.n_nodes = Lc->n, .apply = level_spmv, .ctx = Lc->A};
+    /* down: smooth, restrict the residual (nothing with a single level) */
+    vec_copy(3 * (size_t)M->lev[0].n, in, M->lev[0].r);
+    for (int l = 0; l < c; ++l) {
+        MgLevel *L = &M->lev[l];
         t0 = omp_get_wtime();
-        st = pcg_solve(&op, &M->cj.base, M->proj, in, out, &po, &M->pw, &res);
-        M->info.coarse_s += omp_get_wtime() - t0;
-    } else {
-        vec_copy(3 * (size_t)M->lev[0].n, in, M->lev[0].r);
-        for (int l = 0; l < c; ++l) {
-            MgLevel *L = &M->lev[l];
-            t0 = omp_get_wtime();
-            smooth(M, l, 1, 1);
-            double t1 = omp_get_wtime();
-            restrict_level(M, l, L->r, M->lev[l + 1].r);
-            M->info.smooth_s[l] += t1 - t0;
-            M->info.transfer_apply_s += omp_get_wtime() - t1;
-        }
-        LinearOp op = {.n_nodes = Lc->n, .apply = level_spmv, .ctx = Lc->A};
-        t0 = omp_get_wtime();
-        st = pcg_solve(&op, &M->cj.base, NULL, Lc->r, Lc->u, &po, &M->pw, &res);
-        M->info.coarse_s += omp_get_wtime() - t0;
-        for (int l = c - 1; l >= 0 && !st; --l) {
-            MgLevel *L = &M->lev[l];
-            const size_t len = 3 * (size_t)L->n;
-            t0 = omp_get_wtime();
-            mg_prolong(&L->T, M->lev[l + 1].u, L->d);
-            vec_axpy(len, 1.0, L->d, L->u);
-            bsr_spmv_sub(L->A, L->d, L->r);
-            double t1 = omp_get_wtime();
-            smooth(M, l, 0, 0);
-            M->info.transfer_apply_s += t1 - t0;
-            M->info.smooth_s[l] += omp_get_wtime() - t1;
-        }
-        if (!st) vec_copy(3 * (size_t)M->lev[0].n, M->lev[0].u, out);
+        smooth(M, l, 1, 1);
+        double t1 = omp_get_wtime();
+        restrict_level(M, l, L->r, M->lev[l + 1].r);
+        M->info.smooth_s[l] += t1 - t0;
+        M->info.transfer_apply_s += omp_get_wtime() - t1;
     }
+    /* coarsest: block-Jacobi PCG; on the finest level (a one-level
+     * hierarchy) with the input's Dirichlet projection, coarser levels carry
+     * their BCs in R A P */
+    LinearOp op = {.n_nodes = Lc->n, .apply = level_spmv, .ctx = Lc->A};
+    t0 = omp_get_wtime();
+    st = pcg_solve(&op, &M->cj.base, c == 0 ? M->proj : NULL, Lc->r, Lc->u, &po, &M->pw, &res);
+    M->info.coarse_s += omp_get_wtime() - t0;
+    /* up: prolong and correct, smooth */
+    for (int l = c - 1; l >= 0 && !st; --l) {
+        MgLevel *L = &M->lev[l];
+        const size_t len = 3 * (size_t)L->n;
+        t0 = omp_get_wtime();
+        mg_prolong(&L->T, M->lev[l + 1].u, L->d);
+        vec_axpy(len, 1.0, L->d, L->u);
+        bsr_spmv_sub(L->A, L->d, L->r);
+        double t1 = omp_get_wtime();
+        smooth(M, l, 0, 0);
+        M->info.transfer_apply_s += t1 - t0;
+        M->info.smooth_s[l] += omp_get_wtime() - t1;
+    }
+    if (!st) vec_copy(3 * (size_t)M->lev[0].n, M->lev[0].u, out);
     if (st) return st;
     self->stats.inner_iters += res.iters;
     M->info.coarse_iters += res.iters;
@@ -345,35 +351,46 @@ static void mg_destroy(InvApprox *self)
     free(M);
 }
 
-int mg_is_multigrid(const InvApprox *self)
+static void mg_view(const InvApprox *self, FILE *f, InvView *out)
 {
-    return self && (self->ops == &inv_mg_linear_ops || self->ops == &inv_mg_quadratic_ops || self->ops == &inv_gmg_ops);
+    const Mg *M = (const Mg *)self;
+    const MgInfo *info = &M->info;
+    if (f) {
+        fprintf(f, "multigrid (%s): %d levels, setup %.4f s (transfer %.4f, galerkin %.4f, diagonal %.4f)\n",
+                info->rediscretized ? "geometric, rediscretised from particles"
+                : info->embedding == MG_EMBED_LINEAR ? "linear embedding" : "quadratic embedding",
+                info->n_levels, info->setup_s, info->transfer_s, info->galerkin_s, info->diag_s);
+        for (int l = 0; l < info->n_levels; ++l)
+            fprintf(f, "  level %d: %8d nodes %10lld blocks  blocks/row avg %6.1f max %4d  smooth %.4f s\n", l,
+                    info->n[l], (long long)info->nnzb[l], info->avg_row[l], info->max_row[l], info->smooth_s[l]);
+        if (info->vcycles)
+            fprintf(f,
+                    "  %ld V-cycles: coarse PCG %ld iterations (%.1f per cycle, %ld capped), coarse %.4f s, transfers "
+                    "%.4f s\n",
+                    info->vcycles, info->coarse_iters, (double)info->coarse_iters / info->vcycles, info->coarse_capped,
+                    info->coarse_s, info->transfer_apply_s);
+    }
+    if (!out) return;
+    out->n_levels = info->n_levels < INV_VIEW_MAX_LEVELS ? info->n_levels : INV_VIEW_MAX_LEVELS;
+    for (int l = 0; l < out->n_levels; ++l) {
+        out->level[l].nodes = info->n[l];
+        out->level[l].blocks = info->nnzb[l];
+        out->level[l].blocks_per_row_avg = info->avg_row[l];
+        out->level[l].blocks_per_row_max = info->max_row[l];
+    }
+    inv_view_add(out, "levels", info->n_levels);
+    inv_view_add(out, "vcycles", (double)info->vcycles);
+    inv_view_add(out, "inner_iters", (double)info->coarse_iters); /* coarsest-level PCG */
+    inv_view_add(out, "coarse_capped", (double)info->coarse_capped);
+    inv_view_add(out, "setup_s", info->setup_s);
 }
 
-int mg_get_info(const InvApprox *self, MgInfo *info)
-{
-    if (!self || (self->ops != &inv_mg_linear_ops && self->ops != &inv_mg_quadratic_ops && self->ops != &inv_gmg_ops))
-        return mpm_error(MPM_EINTERNAL, "mg_get_info: not a multigrid inverse approximation");
-    *info = ((const Mg *)self)->info;
-    return MPM_OK;
-}
-
-void mg_print_info(const MgInfo *info, FILE *f)
-{
-    fprintf(f, "multigrid (%s): %d levels, setup %.4f s (transfer %.4f, galerkin %.4f, diagonal %.4f)\n",
-            info->rediscretized ? "geometric, rediscretised from particles"
-            : info->embedding == MG_EMBED_LINEAR ? "linear embedding" : "quadratic embedding",
-            info->n_levels, info->setup_s,
-            info->transfer_s, info->galerkin_s, info->diag_s);
-    for (int l = 0; l < info->n_levels; ++l)
-        fprintf(f, "  level %d: %8d nodes %10lld blocks  blocks/row avg %6.1f max %4d  smooth %.4f s\n", l, info->n[l],
-                (long long)info->nnzb[l], info->avg_row[l], info->max_row[l], info->smooth_s[l]);
-    if (info->vcycles)
-        fprintf(f, "  %ld V-cycles: coarse PCG %ld iterations (%.1f per cycle, %ld capped), coarse %.4f s, transfers %.4f s\n",
-                info->vcycles, info->coarse_iters, (double)info->coarse_iters / info->vcycles, info->coarse_capped,
-                info->coarse_s, info->transfer_apply_s);
-}
-
-const InvApproxOps inv_mg_linear_ops = {"mg-linear", mg_linear_create, mg_setup, mg_apply, mg_destroy};
-const InvApproxOps inv_mg_quadratic_ops = {"mg-quadratic", mg_quadratic_create, mg_setup, mg_apply, mg_destroy};
-const InvApproxOps inv_gmg_ops = {"gmg", gmg_create, mg_setup, mg_apply, mg_destroy};
+const InvApproxOps inv_mg_ops = {
+    "mg",
+    "node-embedding Galerkin multigrid V-cycle (HOT; embedding=linear|quadratic), or with rediscretize=1 the "
+    "particle-rediscretised geometric one (LBFGS-GMG)",
+    mg_create,
+    mg_setup,
+    mg_apply,
+    mg_view,
+    mg_destroy};

@@ -19,51 +19,30 @@
  * With one level this is block-Jacobi PCG on H with the same 1/2 rule
  * (LBFGS-H), using the input projection.
  *
- * Options (--solver-opt): levels (3), sweeps (1), min_coarse_nodes (300),
- * coarse_tol (0.5), coarse_max_iters (10000), coarse_exact (0; 1 sets
- * coarse_tol = 1e-12, used to test that the V-cycle is then symmetric),
- * flexible (1: outer PCG uses the flexible-CG update), and for the Galerkin
- * hierarchies embedding (linear | quadratic; the preset's kernel by default).
- * stats.inner_iters counts coarse PCG iterations since the last setup. */
+ * Registered as "mg" (inv_mg_ops), one implementation for the three
+ * hierarchies of the study:
+ *  - rediscretize=0 (default): Galerkin coarse levels R A P with the
+ *    embedding=linear (default; HOT, PN-MGPCG) or quadratic (HOT-quadratic)
+ *    kernel;
+ *  - rediscretize=1: the baseline geometric multigrid of SPEC 6 (LBFGS-GMG,
+ *    PN-GMG-PCG): every coarse level is rediscretised from the particles at
+ *    spacing 2^l dx (mg/gmg_level.h) and linked by linear transfers; needs
+ *    InvSetupInput.problem with a current tangent; option coarse_bc_project
+ *    (1) projects restricted residuals at each coarse level's Dirichlet nodes.
+ * Options: levels (3), sweeps (1), min_coarse_nodes (300), coarse_tol (0.5),
+ * coarse_max_iters (10000), coarse_exact (0; 1 sets coarse_tol = 1e-12, the
+ * V-cycle is then a fixed symmetric map to that accuracy), flexible (1: outer
+ * PCG uses the flexible-CG update). Integer options must be integers in
+ * range. stats.inner_iters counts coarse PCG iterations since the last setup;
+ * the view op prints and returns the hierarchy (nodes, blocks per row per
+ * level: HOT Fig. 8) and the V-cycle counts. */
 #ifndef MPM_MG_MG_H
 #define MPM_MG_MG_H
-
-#include <stdint.h>
-#include <stdio.h>
 
 #include "solvers/inverse_approx.h"
 
 #define MG_MAX_LEVELS 12
 
-extern const InvApproxOps inv_mg_linear_ops;    /* "mg-linear": HOT, PN-MGPCG */
-extern const InvApproxOps inv_mg_quadratic_ops; /* "mg-quadratic": HOT-quadratic */
-/* "gmg": the baseline geometric multigrid of SPEC 6 (LBFGS-GMG, PN-GMG-PCG):
- * the same V-cycle, but every coarse level is rediscretised from the
- * particles at spacing 2^l dx (mg/gmg_level.h) instead of R A P; needs
- * InvSetupInput.problem with a current tangent. */
-extern const InvApproxOps inv_gmg_ops;
-
-typedef struct {
-    int n_levels;
-    int embedding; /* MgEmbedding */
-    int rediscretized; /* baseline GMG */
-    int n[MG_MAX_LEVELS];              /* nodes per level */
-    int64_t nnzb[MG_MAX_LEVELS];       /* stored blocks per level */
-    double avg_row[MG_MAX_LEVELS];     /* nonzero blocks per row, mean */
-    int max_row[MG_MAX_LEVELS];        /* and max */
-    double setup_s;                    /* whole setup (last call) */
-    double transfer_s, galerkin_s, diag_s; /* parts of it */
-    long vcycles, coarse_iters, coarse_capped; /* since the last setup */
-    double smooth_s[MG_MAX_LEVELS];    /* apply time split, since the last setup */
-    double transfer_apply_s, coarse_s;
-} MgInfo;
-
-/* Non-zero when self is one of the multigrid inverse approximations. */
-int mg_is_multigrid(const InvApprox *self);
-/* Fills info for an InvApprox created from one of the two tables above
- * (MPM_EINTERNAL for any other). */
-int mg_get_info(const InvApprox *self, MgInfo *info);
-/* One line per level: nodes, blocks, blocks per row (avg/max); setup times. */
-void mg_print_info(const MgInfo *info, FILE *f);
+extern const InvApproxOps inv_mg_ops;
 
 #endif

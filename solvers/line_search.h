@@ -1,0 +1,44 @@
+/* Line-search strategies an outer method is handed (DESIGN "the one idea";
+ * SPEC 5): chosen by the solver option `linesearch=NAME`, never a code path
+ * inside a method. Adding one (e.g. strong Wolfe, Nocedal & Wright
+ * Alg. 3.5/3.6) is one function with this signature, a LineSearchOps and one
+ * line in the table of line_search.c.
+ *
+ * Contract of search(): from dv along the descent direction p (gTp = g(dv).p
+ * < 0, E0 = E(dv), g0 = g(dv)) find dv_new = dv + alpha p with an acceptable
+ * energy. On success (stalled == 0) the problem's cache holds dv_new and, when
+ * the strategy evaluated it anyway, g_new = g(dv_new) with have_gradient = 1
+ * (else the caller evaluates it). With no acceptable alpha it sets stalled,
+ * leaves the cache at dv and says why in `why`. It never accepts an energy
+ * above E0 (tests/test_conformance.c). */
+#ifndef MPM_LINE_SEARCH_H
+#define MPM_LINE_SEARCH_H
+
+#include "core/problem.h"
+
+typedef struct {
+    int max_halvings; /* 60 (SPEC 5) */
+} LineSearchParams;
+
+typedef struct {
+    double alpha;
+    double energy;     /* E(dv_new) */
+    int evals;         /* energy evaluations */
+    int have_gradient; /* g_new = g(dv_new) filled */
+    int stalled;
+    char why[96];      /* when stalled */
+} LineSearchOutcome;
+
+typedef struct {
+    const char *name;
+    const char *description;
+    int (*search)(StepProblem *pb, const double *dv, const double *p, double E0, const double *g0, double gTp,
+                  const LineSearchParams *prm, double *dv_new, double *g_new, LineSearchOutcome *out);
+} LineSearchOps;
+
+int line_search_count(void);
+const LineSearchOps *line_search_get(int i);
+/* NULL when unknown. */
+const LineSearchOps *line_search_find(const char *name);
+
+#endif

@@ -1,0 +1,141 @@
+/* What every outer method shares (see outer_method.h): the stopping test,
+ * the timed phases, the operators. */
+#include "solvers/outer_method.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+
+const char *solve_status_name(SolveStatus s)
+{
+    switch (s) {
+    case SOLVE_CONVERGED: return "converged";
+    case SOLVE_CAPPED: return "capped";
+    case SOLVE_STALLED: return "stalled";
+    case SOLVE_TIMEOUT: return "timeout";
+    default: return "failed";
+    }
+}
+
+int solve_end(SolveStats *st, SolveStatus status, const char *fmt, ...)
+{
+    st->status = status;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(st->reason, sizeof st->reason, fmt, ap);
+    va_end(ap);
+    return 1;
+}
+
+int solve_should_stop(SolveCtx *c, const double *g, double E, int it, SolveStats *st)
+{
+    double res = problem_cn_residual(c->pb, g);
+    st->residual = res;
+    double now = omp_get_wtime();
+    if (c->hook) c->hook(c->hook_ctx, it, now - c->t_start, res, E);
+    if (!isfinite(res) || !isfinite(E))
+        return solve_end(st, SOLVE_FAILED, "non-finite %s (%g) at outer iteration %d", isfinite(E) ? "residual" : "energy",
+                         isfinite(E) ? res : E, it);
+    if (c->stop->measure(c->pb, g, res) < c->stop_tol) {
+        st->status = SOLVE_CONVERGED;
+        st->reason[0] = '\0';
+        return 1;
+    }
+    if (it >= c->set->max_outer) return solve_end(st, SOLVE_CAPPED, "outer iteration cap %d reached", c->set->max_outer);
+    if (c->set->deadline > 0 && now >= c->set->deadline)
+        return solve_end(st, SOLVE_TIMEOUT, "time limit %s reached after %d outer iterations",
+                         c->set->deadline_reason ? c->set->deadline_reason : "", it);
+    int progress = 0;
+    if (E < c->best_energy) c->best_energy = E, progress = 1;
+    if (res < c->best_residual) c->best_residual = res, progress = 1;
+    if (progress) c->last_progress = it;
+    else if (it - c->last_progress >= c->stall_iters)
+        return solve_end(st, SOLVE_STALLED, "no decrease of the energy or the residual in %d outer iterations",
+                         c->stall_iters);
+    return 0;
+}
+
+static void apply_assembled(const void *ctx, const double *x, double *y) { bsr_spmv((const Bsr *)ctx, x, y); }
+
+static void apply_matrix_free(const void *ctx, const double *x, double *y)
+{
+    problem_hessvec((StepProblem *)ctx, x, y);
+}
+
+static void apply_projection(const void *ctx, double *v) { problem_project((const StepProblem *)ctx, v); }
+
+void solve_hessian_op(SolveCtx *c, const Bsr *H, LinearOp *op)
+{
+    op->n_nodes = c->pb->n_nodes;
+    op->apply = H ? apply_assembled : apply_matrix_free;
+    op->ctx = H ? (const void *)H : (const void *)c->pb;
+}
+
+void solve_projection(SolveCtx *c, Projection *P)
+{
+    P->apply = c->pb->n_dirichlet ? apply_projection : NULL;
+    P->ctx = c->pb;
+}
+
+int solve_assemble(SolveCtx *c, Bsr *H, double *diag, SolveStats *st)
+{
+    double t0 = omp_get_wtime();
+    int status = problem_tangent(c->pb, 1);
+    if (!status && H) status = problem_assemble(c->pb, H);
+    if (!status) {
+        if (H) bsr_diagonal(H, diag);
+        else problem_diagonal(c->pb, diag);
+    }
+    st->assemble_s += omp_get_wtime() - t0;
+    return status;
+}
+
+int solve_setup_inverse(SolveCtx *c, const Bsr *H, const double *diag, const LinearOp *op, const Projection *proj,
+                        SolveStats *st)
+{
+    double t0 = omp_get_wtime();
+    StepProblem *pb = c->pb;
+    InvSetupInput in = {
+        .n_nodes = pb->n_nodes,
+        .H = H,
+        .diag = diag,
+        .coord = pb->grid->coord,
+        .coloring = &pb->grid->coloring,
+        .op = op,
+        .proj = proj,
+        .problem = pb,
+    };
+    int status = inv_setup(c->inv, &in);
+    st->setup_s += omp_get_wtime() - t0;
+    return status;
+}
+
+int solve_line_search(SolveCtx *c, const double *dv, const double *g, const double *p, double E0, double gTp,
+                      double *dv_new, double *g_new, LineSearchOutcome *out, SolveStats *st)
+{
+    double t0 = omp_get_wtime();
+    LineSearchParams prm = {c->set->max_halvings};
+    int status = c->ls->search(c->pb, dv, p, E0, g, gTp, &prm, dv_new, g_new, out);
+    st->ls_evals += out->evals;
+    if (!status && out->stalled) solve_end(st, SOLVE_STALLED, "%s", out->why);
+    else if (!status && !out->have_gradient) problem_gradient(c->pb, dv_new, g_new);
+    st->linesearch_s += omp_get_wtime() - t0;
+    return status;
+}
+
+int solve_reserve(double **const *vecs, const size_t *per_node, int count, int n, int *cap)
+{
+    if (n <= *cap) return MPM_OK;
+    int c = n + n / 4 + 256;
+    for (int k = 0; k < count; ++k) {
+        double *q = realloc(*vecs[k], sizeof(double) * per_node[k] * (size_t)c);
+        if (!q) return mpm_error(MPM_EINTERNAL, "out of memory: solver work vectors (%d nodes)", n);
+        *vecs[k] = q;
+    }
+    *cap = c;
+    return MPM_OK;
+}

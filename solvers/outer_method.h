@@ -1,0 +1,153 @@
+/* The outer-method interface (DESIGN "the one idea"): projected Newton,
+ * L-BFGS, ... as objects with an ops table and a private context, registered
+ * by name in experiments/registry.c like the inverse approximations.
+ *
+ * A method minimises the step problem's incremental potential from dv. It is
+ * handed, in a SolveCtx, everything that is not its own algorithm: the
+ * inverse approximation, the line-search strategy (solvers/line_search.h)
+ * and the stopping rule (solvers/stop_rule.h) chosen by options, the caps and
+ * time limit, and the iteration hook. It calls the helpers below so that
+ * every method stops, times and counts by the same rules:
+ *  - solve_should_stop() at the top of every iteration (convergence, the
+ *    outer cap, the time limit, stagnation, non-finite values);
+ *  - solve_assemble() / solve_setup_inverse() / solve_line_search() for the
+ *    phases timed in SolveStats.
+ * Adding an outer method is one new file defining its OuterMethodOps and one
+ * line in experiments/registry.c; tests/test_conformance.c then checks it
+ * (when it claims OUTER_TO_TOLERANCE: reaches eps, honours the cap with
+ * status capped, stalls at an unreachable tolerance; when it claims
+ * OUTER_DESCENT: never accepts an energy increase).
+ *
+ * Statistics contract (SolveStats, README "Solvers"):
+ *  - outer_iters: iterations of the outer method;
+ *  - linear_iters: PCG iterations of the outer method's own linear solves
+ *    (PN's H p = -g; 0 for L-BFGS, which solves none);
+ *  - inner_iters: iterations inside the inverse approximation (coarsest-level
+ *    PCG of a V-cycle, LBFGS-H's PCG), counted by the solver layer;
+ *  - phase timers, together covering the solve: assemble_s (tangent
+ *    stiffness, Hessian assembly or matrix-free diagonal), setup_s (inverse
+ *    approximation setup), solve_s (the direction: PCG, two-loop recursion),
+ *    linesearch_s (every energy and gradient evaluation: the initial point,
+ *    the line-search trials, the gradient at the accepted point). */
+#ifndef MPM_OUTER_METHOD_H
+#define MPM_OUTER_METHOD_H
+
+#include <stdint.h>
+#include <stdio.h>
+
+#include "core/bsr.h"
+#include "core/problem.h"
+#include "solvers/inverse_approx.h"
+#include "solvers/line_search.h"
+#include "solvers/options.h"
+#include "solvers/stop_rule.h"
+
+/* Ordered by severity (a frame reports its worst step). */
+typedef enum { SOLVE_CONVERGED = 0, SOLVE_CAPPED, SOLVE_STALLED, SOLVE_TIMEOUT, SOLVE_FAILED } SolveStatus;
+const char *solve_status_name(SolveStatus s);
+
+typedef struct {
+    double eps;           /* CN tolerance (SPEC 4), default 1e-7 */
+    int max_outer;        /* 10000 */
+    int max_linear;       /* 10000: PCG iterations per linear solve */
+    int max_halvings;     /* 60 */
+    double deadline;      /* omp_get_wtime() at which the solve stops as timeout; 0 = none */
+    const char *deadline_reason; /* for the status reason, e.g. "--max-step-seconds 5" */
+} SolveSettings;
+
+typedef struct {
+    int outer_iters;
+    long linear_iters;
+    long inner_iters;
+    int ls_evals;         /* energy evaluations */
+    double residual;      /* scaled CN residual at the returned dv */
+    SolveStatus status;
+    char reason[256];     /* why the solve did not converge ("" when it did) */
+    double assemble_s, setup_s, solve_s, linesearch_s;
+    int64_t hessian_blocks;
+    size_t hessian_bytes;
+} SolveStats;
+
+/* Called at every outer iteration with the CN residual and energy. */
+typedef void (*IterHook)(void *ctx, int iter, double elapsed_s, double residual, double energy);
+
+enum {
+    OUTER_DESCENT = 1u << 0,      /* never accepts an iterate of higher energy */
+    OUTER_TO_TOLERANCE = 1u << 1, /* iterates until the stopping rule holds (not, e.g., a
+                                     semi-implicit method's single linearised solve) */
+};
+
+typedef struct SolveCtx SolveCtx;
+typedef struct OuterMethod OuterMethod;
+typedef struct {
+    const char *name;
+    const char *description;
+    unsigned flags; /* OUTER_* */
+    /* Reads the options and allocates; sets base.ops and base.assembled. */
+    int (*create)(SolverOptions *opt, OuterMethod **out);
+    /* dv: in the initial guess, out the last accepted iterate. Returns
+     * MPM_ENUMERIC on a numerical breakdown (the solver layer turns it into
+     * status failed with the message as reason). */
+    int (*solve)(OuterMethod *self, SolveCtx *ctx, double *dv, SolveStats *st);
+    void (*view)(const OuterMethod *self, FILE *f);
+    void (*destroy)(OuterMethod *self);
+} OuterMethodOps;
+
+struct OuterMethod {
+    const OuterMethodOps *ops;
+    /* sets its inverse approximation up from the assembled Hessian; 0 =
+     * matrix-free (an inverse approximation with INV_NEEDS_MATRIX is then
+     * refused when the solver is created) */
+    int assembled;
+};
+
+struct SolveCtx {
+    StepProblem *pb;
+    InvApprox *inv;                /* never NULL */
+    const LineSearchOps *ls;
+    const StopRuleOps *stop;
+    double stop_tol;               /* threshold of stop->measure */
+    int stall_iters;               /* k of the stagnation rule */
+    const SolveSettings *set;
+    IterHook hook;
+    void *hook_ctx;
+    /* kept by solve_should_stop */
+    double t_start, best_energy, best_residual;
+    int last_progress;
+};
+
+/* The stopping test at the top of iteration `it` (g = gradient at the
+ * current iterate, E its energy): records the CN residual in st, calls the
+ * hook and returns 1 with st->status and st->reason set when the solve ends
+ * here:
+ *   failed    non-finite energy or residual;
+ *   converged stop->measure < stop_tol;
+ *   capped    it >= max_outer;
+ *   timeout   past set->deadline;
+ *   stalled   neither the energy nor the residual went below its best value
+ *             for stall_iters iterations (an accepted equal energy counts as
+ *             no decrease, so a stagnated solve cannot loop forever). */
+int solve_should_stop(SolveCtx *c, const double *g, double E, int it, SolveStats *st);
+/* Ends the solve with `status` and a printf-style reason; returns 1. */
+int solve_end(SolveStats *st, SolveStatus status, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+/* The BC-projected Hessian as an operator: assembled H, or matrix-free
+ * problem_hessvec when H is NULL. */
+void solve_hessian_op(SolveCtx *c, const Bsr *H, LinearOp *op);
+void solve_projection(SolveCtx *c, Projection *P);
+/* Tangent stiffness at the cached iterate, then H (when not NULL) and the 9n
+ * diagonal blocks (from H, or matrix-free); timed as assemble_s. */
+int solve_assemble(SolveCtx *c, Bsr *H, double *diag, SolveStats *st);
+/* Sets the inverse approximation up at the current tangent; timed as setup_s. */
+int solve_setup_inverse(SolveCtx *c, const Bsr *H, const double *diag, const LinearOp *op, const Projection *proj,
+                        SolveStats *st);
+/* The line-search strategy from dv along p, then the gradient at the
+ * accepted point into g_new (unless the strategy gave it); everything timed
+ * as linesearch_s. When it stalls: st->status stalled with the strategy's
+ * reason, the cache left at dv. */
+int solve_line_search(SolveCtx *c, const double *dv, const double *g, const double *p, double E0, double gTp,
+                      double *dv_new, double *g_new, LineSearchOutcome *out, SolveStats *st);
+/* Grows vecs[k] to per_node[k] doubles per node for n nodes, k < count
+ * (capacity in nodes kept in *cap, grown with headroom). */
+int solve_reserve(double **const *vecs, const size_t *per_node, int count, int n, int *cap);
+
+#endif
