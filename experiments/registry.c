@@ -11,7 +11,9 @@
  * (solvers/<name>.c); the list declares and registers it. */
 #define OUTER_METHODS(X) \
     X(outer_pn)          \
-    X(outer_lbfgs)
+    X(outer_lbfgs)       \
+    X(outer_gast15)      \
+    X(outer_semi_implicit)
 
 /* Inverse approximations: one line each (solvers/, adapters/). */
 #define INVERSE_APPROXIMATIONS(X) \
@@ -21,7 +23,8 @@
     X(inv_mg_ops)                 \
     X(inv_inexact_pcg_ops)        \
     X(inv_cholmod_ops)            \
-    X(inv_boomeramg_ops)
+    X(inv_boomeramg_ops)          \
+    X(inv_gast_diagonal_ops)
 
 #define DECLARE_OUTER(sym) extern const OuterMethodOps sym;
 #define DECLARE_INVERSE(sym) extern const InvApproxOps sym;
@@ -58,6 +61,12 @@ static const SolverPreset g_presets[] = {
     {"lbfgs-h-direct", "L-BFGS, initial inverse = CHOLMOD factor of the start-of-step Hessian (Li et al. 2019)", "lbfgs",
      "cholmod", ""},
     {"lbfgs-amg", "L-BFGS, initial inverse = one hypre BoomerAMG V-cycle", "lbfgs", "boomeramg", ""},
+    {"gast15", "Gast et al. 2015: unprojected Newton, CG stopping at indefiniteness, strong Wolfe, ||g|| < 1e-3, "
+     "rest-configuration diagonal preconditioner, matrix-free", "gast15", "gast-diagonal", "linesearch=wolfe,stop=l2"},
+    {"gast15-hot", "what the HOT study ran as Gast15: matrix-free projected Newton, block Jacobi, halving, ||g|| < 1e-3, "
+     "PCG to min(0.5, sqrt(max(||g||, 1e-3)))", "pn", "block-jacobi", "matrix_free=1,stop=l2,forcing=gast"},
+    {"semi-implicit", "Stomakhin et al. 2013: one linearised backward-Euler solve per step (MINRES, unprojected "
+     "Hessian at x^n), no line search", "semi-implicit", "gast-diagonal", ""},
 };
 
 #define COUNT(a) ((int)(sizeof(a) / sizeof((a)[0])))

@@ -1,8 +1,10 @@
 /* Line-search strategies an outer method is handed (DESIGN "the one idea";
  * SPEC 5): chosen by the solver option `linesearch=NAME`, never a code path
- * inside a method. Adding one (e.g. strong Wolfe, Nocedal & Wright
- * Alg. 3.5/3.6) is one function with this signature, a LineSearchOps and one
- * line in the table of line_search.c.
+ * inside a method: "halving" (the reference rule, SPEC 5), "armijo" and
+ * "wolfe" (strong Wolfe conditions, Nocedal & Wright Alg. 3.5/3.6, as Gast
+ * et al. 2015 §3.1 use; alpha may exceed 1). Adding one is one function with
+ * this signature, a LineSearchOps and one line in the table of
+ * line_search.c.
  *
  * Contract of search(): from dv along the descent direction p (gTp = g(dv).p
  * < 0, E0 = E(dv), g0 = g(dv)) find dv_new = dv + alpha p with an acceptable
@@ -25,6 +27,9 @@ typedef struct {
     double energy;     /* E(dv_new) */
     int evals;         /* energy evaluations */
     int have_gradient; /* g_new = g(dv_new) filled */
+    int conditions_met; /* wolfe: both strong Wolfe conditions hold at alpha (0 when
+                           the evaluation budget ran out and the best point with
+                           sufficient decrease was taken); the others: 1 */
     int stalled;
     char why[96];      /* when stalled */
 } LineSearchOutcome;
@@ -40,5 +45,11 @@ int line_search_count(void);
 const LineSearchOps *line_search_get(int i);
 /* NULL when unknown. */
 const LineSearchOps *line_search_find(const char *name);
+
+/* Strong Wolfe constants (Nocedal & Wright §3.1: c1 = 1e-4, c2 = 0.9 for
+ * Newton-type directions) and the largest step the expansion tries. */
+#define WOLFE_C1 1e-4
+#define WOLFE_C2 0.9
+#define WOLFE_ALPHA_MAX 1e6
 
 #endif

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/vec.h"
 
 const char *solve_status_name(SolveStatus s)
 {
@@ -81,10 +82,10 @@ void solve_projection(SolveCtx *c, Projection *P)
     P->ctx = c->pb;
 }
 
-int solve_assemble(SolveCtx *c, Bsr *H, double *diag, SolveStats *st)
+static int assemble(SolveCtx *c, int projected, Bsr *H, double *diag, SolveStats *st)
 {
     double t0 = omp_get_wtime();
-    int status = problem_tangent(c->pb, 1);
+    int status = problem_tangent(c->pb, projected);
     if (!status && H) status = problem_assemble(c->pb, H);
     if (!status) {
         if (H) bsr_diagonal(H, diag);
@@ -92,6 +93,19 @@ int solve_assemble(SolveCtx *c, Bsr *H, double *diag, SolveStats *st)
     }
     st->assemble_s += omp_get_wtime() - t0;
     return status;
+}
+
+int solve_assemble(SolveCtx *c, Bsr *H, double *diag, SolveStats *st) { return assemble(c, 1, H, diag, st); }
+
+int solve_assemble_unprojected(SolveCtx *c, Bsr *H, double *diag, SolveStats *st)
+{
+    return assemble(c, 0, H, diag, st);
+}
+
+double solve_gradient_tolerance(const SolveCtx *c)
+{
+    if (strcmp(c->stop->name, "l2") == 0) return c->stop_tol;
+    return problem_tau(c->pb, c->stop_tol);
 }
 
 int solve_setup_inverse(SolveCtx *c, const Bsr *H, const double *diag, const LinearOp *op, const Projection *proj,
@@ -125,6 +139,17 @@ int solve_line_search(SolveCtx *c, const double *dv, const double *g, const doub
     else if (!status && !out->have_gradient) problem_gradient(c->pb, dv_new, g_new);
     st->linesearch_s += omp_get_wtime() - t0;
     return status;
+}
+
+void solve_keep_dirichlet(const StepProblem *pb, const double *dv, const double *free_part, double *out, double *tmp)
+{
+    const size_t len = 3 * (size_t)pb->n_nodes;
+    vec_copy(len, dv, tmp);
+    problem_project(pb, tmp);
+    if (out != free_part) vec_copy(len, free_part, out);
+    problem_project(pb, out);
+    vec_axpy(len, -1.0, tmp, out);
+    vec_axpy(len, 1.0, dv, out);
 }
 
 int solve_reserve(double **const *vecs, const size_t *per_node, int count, int n, int *cap)

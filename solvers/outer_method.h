@@ -135,8 +135,17 @@ int solve_end(SolveStats *st, SolveStatus status, const char *fmt, ...) __attrib
 void solve_hessian_op(SolveCtx *c, const Bsr *H, LinearOp *op);
 void solve_projection(SolveCtx *c, Projection *P);
 /* Tangent stiffness at the cached iterate, then H (when not NULL) and the 9n
- * diagonal blocks (from H, or matrix-free); timed as assemble_s. */
+ * diagonal blocks (from H, or matrix-free); timed as assemble_s.
+ * solve_assemble uses the projected (SPD) tangent of SPEC 3, the one every
+ * HOT-study solver sees; solve_assemble_unprojected the true dP/dF, which
+ * may be indefinite (Gast et al. 2015's Newton, the semi-implicit method). */
 int solve_assemble(SolveCtx *c, Bsr *H, double *diag, SolveStats *st);
+int solve_assemble_unprojected(SolveCtx *c, Bsr *H, double *diag, SolveStats *st);
+/* tau_g of Gast et al. 2015 §3.1's forcing term min(1/2, sigma sqrt(max(||g||,
+ * tau_g))): the termination tolerance on ||g||, i.e. the stop rule's own
+ * tolerance for "l2", and for the CN rule its L2 equivalent problem_tau(pb,
+ * eps) (SPEC 4; the HOT code's newton.tolerance with --usecn). */
+double solve_gradient_tolerance(const SolveCtx *c);
 /* Sets the inverse approximation up at the current tangent; timed as setup_s. */
 int solve_setup_inverse(SolveCtx *c, const Bsr *H, const double *diag, const LinearOp *op, const Projection *proj,
                         SolveStats *st);
@@ -146,6 +155,10 @@ int solve_setup_inverse(SolveCtx *c, const Bsr *H, const double *diag, const Lin
  * reason, the cache left at dv. */
 int solve_line_search(SolveCtx *c, const double *dv, const double *g, const double *p, double E0, double gTp,
                       double *dv_new, double *g_new, LineSearchOutcome *out, SolveStats *st);
+/* out = (I - P) dv + P free: dv's Dirichlet components with `free` on the
+ * free subspace (P the BC projection); out may alias free but not dv, tmp (3n) is
+ * scratch. For initial guesses and linearisation points other than dv. */
+void solve_keep_dirichlet(const StepProblem *pb, const double *dv, const double *free_part, double *out, double *tmp);
 /* Grows vecs[k] to per_node[k] doubles per node for n nodes, k < count
  * (capacity in nodes kept in *cap, grown with headroom). */
 int solve_reserve(double **const *vecs, const size_t *per_node, int count, int n, int *cap);

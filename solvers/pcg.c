@@ -3,7 +3,8 @@
  *
  *   x = 0;  r = P(b);  z = P(M^-1 r);  p = z;  rho0 = sqrt(r^T z)
  *   loop (check at the top):
- *     stop if sqrt(r^T z) < threshold         (forcing term or absolute)
+ *     stop if sqrt(r^T z) < threshold         (forcing term, absolute, relative;
+ *                                              PCG_RELATIVE_L2 compares ||r||_2)
  *     stop if max_iters iterations were done  (capped = 1)
  *     q = P(A p);  alpha = r^T z / p^T q
  *     stop if p^T q <= 0                      (non-positive curvature)
@@ -19,9 +20,8 @@
  * Comput. 22(4)), which equals the plain beta in exact arithmetic when M is
  * fixed and SPD.
  *
- * Non-positive curvature: pcg.h has no flag for it, so it shows as a stop
- * with capped == 0 and rho not below the threshold. Following Gast et al.
- * 2015 §6 ("if indefiniteness is encountered during the conjugate gradient
+ * Non-positive curvature (PcgResult.indefinite): following Gast et al.
+ * 2015 §3.1 ("if indefiniteness is encountered during the conjugate gradient
  * solve, return the last iterate computed; if this occurs on the first step,
  * return the right hand side"), x is then the last iterate, or P(b) when it
  * happens in the first iteration, so the result is always a descent direction
@@ -82,6 +82,7 @@ int pcg_solve(const LinearOp *A, InvApprox *M, const Projection *proj, const dou
     res->iters = 0;
     res->capped = 0;
     res->timed_out = 0;
+    res->indefinite = 0;
     res->rho0 = res->rho = 0.0;
     const int n = A->n_nodes;
     const size_t len = 3 * (size_t)n;
@@ -103,19 +104,27 @@ int pcg_solve(const LinearOp *A, InvApprox *M, const Projection *proj, const dou
     res->rho0 = res->rho = rho0;
     if (rz == 0.0) return MPM_OK; /* b is zero in the free subspace: x = 0 is exact */
 
+    /* the stopping test compares `measure` (the preconditioned norm rho, or
+     * the plain ||r||_2 for PCG_RELATIVE_L2) with `threshold` */
+    const int l2 = opt->stop == PCG_RELATIVE_L2;
     double threshold;
     if (opt->stop == PCG_FORCING) {
         double eta = fmin(0.5, sqrt(fmax(rho0, opt->tau)));
         threshold = eta * rho0;
-    } else {
+    } else if (opt->stop == PCG_ABSOLUTE) {
         threshold = opt->abs_tol;
+    } else if (opt->stop == PCG_RELATIVE) {
+        threshold = opt->rel_tol * rho0;
+    } else {
+        threshold = opt->rel_tol * vec_norm(len, r);
     }
 
     vec_copy(len, z, p);
     double rho = rho0;
+    double measure = l2 ? vec_norm(len, r) : rho0;
     int it = 0;
     for (;;) {
-        if (rho < threshold) break;
+        if (measure < threshold) break;
         if (it >= opt->max_iters) {
             res->capped = 1;
             break;
@@ -129,6 +138,7 @@ int pcg_solve(const LinearOp *A, InvApprox *M, const Projection *proj, const dou
         double pq = vec_dot(len, p, q);
         if (!(pq > 0.0)) { /* also catches NaN */
             if (it == 0) vec_copy(len, r, x);
+            res->indefinite = 1;
             break;
         }
         double alpha = rz / pq;
@@ -148,6 +158,7 @@ int pcg_solve(const LinearOp *A, InvApprox *M, const Projection *proj, const dou
         vec_xpby(len, z, beta, p);
         rz = rz_new;
         rho = sqrt(rz);
+        measure = l2 ? vec_norm(len, r) : rho;
         if (rz == 0.0) break; /* exact solution reached */
     }
     res->iters = it;

@@ -71,7 +71,7 @@ static int ipcg_apply(InvApprox *self, const double *r, double *z)
     int st = inv_apply(s->jacobi, r, s->z);
     if (st) return st;
     double ref = sqrt(fmax(vec_dot(len, r, s->z), 0.0));
-    PcgOptions po = {PCG_ABSOLUTE, 0.0, 0.5 * ref, s->max_iters, 0.0};
+    PcgOptions po = {.stop = PCG_ABSOLUTE, .abs_tol = 0.5 * ref, .max_iters = s->max_iters};
     PcgResult res;
     st = pcg_solve(s->op, s->jacobi, s->proj, r, z, &po, &s->work, &res);
     self->stats.inner_iters += res.iters;

@@ -6,9 +6,16 @@
  *
  * Options: matrix_free (0): 1 applies H through the matrix-free product
  * (SPEC 3) and sets the inverse approximation up from the diagonal blocks
- * only (HOT PN-PCG(MF)). */
+ * only (HOT PN-PCG(MF)); forcing (cn): the PCG stop, "cn" the forcing term
+ * above on the preconditioned norm with tau the CN floor of SPEC 4, "gast"
+ * what the HOT code runs as Gast15 (USE_GAST15_METRIC, reference §3 item 7):
+ * sqrt(r^T M^-1 r) < eta rho0 with eta = min(0.5, sqrt(max(||g||, tau_g))),
+ * ||g|| the plain L2 norm of the gradient and tau_g the termination
+ * tolerance on it (the `tau` of stop=l2). */
+#include <math.h>
 #include <omp.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "core/error.h"
 #include "core/vec.h"
@@ -18,6 +25,7 @@
 typedef struct {
     OuterMethod base;
     int cap;
+    int forcing_gast;
     double *g, *g_new, *p, *rhs, *dv_new, *diag; /* 3n each, diag 9n */
     Bsr H;
     PcgWork pcg;
@@ -30,10 +38,14 @@ static int pn_create(SolverOptions *opt, OuterMethod **out)
     int st = MPM_OK;
     int matrix_free = solver_opt_int(opt, "matrix_free", 0, 0, 1, &st);
     if (st) return st;
+    const char *forcing = solver_opt_string(opt, "forcing", "cn");
+    if (strcmp(forcing, "cn") != 0 && strcmp(forcing, "gast") != 0)
+        return mpm_error(MPM_EINPUT, "solver option forcing=%s: expected cn or gast", forcing);
     Pn *s = calloc(1, sizeof *s);
     if (!s) return mpm_error(MPM_EINTERNAL, "out of memory: projected Newton");
     s->base.ops = &outer_pn;
     s->base.assembled = !matrix_free;
+    s->forcing_gast = strcmp(forcing, "gast") == 0;
     *out = &s->base;
     return MPM_OK;
 }
@@ -55,6 +67,7 @@ static int pn_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *st)
     problem_gradient(pb, dv, s->g);
     st->linesearch_s += omp_get_wtime() - t0;
     const double tau = problem_tau(pb, c->set->eps);
+    const double tau_g = solve_gradient_tolerance(c);
     LinearOp op;
     Projection proj;
     solve_hessian_op(c, H, &op);
@@ -67,7 +80,12 @@ static int pn_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *st)
 
         double t2 = omp_get_wtime();
         for (size_t k = 0; k < len; ++k) s->rhs[k] = -s->g[k];
-        PcgOptions po = {PCG_FORCING, tau, 0.0, c->set->max_linear, c->set->deadline};
+        PcgOptions po = {.stop = PCG_FORCING, .tau = tau, .max_iters = c->set->max_linear,
+                         .deadline = c->set->deadline};
+        if (s->forcing_gast) {
+            po.stop = PCG_RELATIVE;
+            po.rel_tol = fmin(0.5, sqrt(fmax(vec_norm(len, s->g), tau_g)));
+        }
         PcgResult pr;
         status = pcg_solve(&op, c->inv, &proj, s->rhs, s->p, &po, &s->pcg, &pr);
         st->linear_iters += pr.iters;
@@ -105,8 +123,10 @@ static int pn_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *st)
 
 static void pn_view(const OuterMethod *self, FILE *f)
 {
-    fprintf(f, "  projected Newton: %s Hessian, inexact PCG with the forcing term min(0.5, sqrt(max(rho0, tau)))\n",
-            self->assembled ? "assembled" : "matrix-free");
+    const Pn *s = (const Pn *)self;
+    fprintf(f, "  projected Newton: %s Hessian, inexact PCG with the forcing term %s\n",
+            self->assembled ? "assembled" : "matrix-free",
+            s->forcing_gast ? "min(0.5, sqrt(max(||g||, tau_g))) (HOT's Gast15)" : "min(0.5, sqrt(max(rho0, tau)))");
 }
 
 static void pn_destroy(OuterMethod *self)

@@ -250,7 +250,7 @@ int main(void)
             for (int f = 0; f < 2; ++f) {
                 pre[v]->flexible = f;
                 if (v == 1) { /* same tolerance in the same (block-Jacobi) norm scale */
-                    pcg_solve(&q.op, inner, &q.proj, bq, xq, &(PcgOptions){PCG_ABSOLUTE, 0, 0, 0, 0}, &work, &res);
+                    pcg_solve(&q.op, inner, &q.proj, bq, xq, &(PcgOptions){.stop = PCG_ABSOLUTE}, &work, &res);
                     o.abs_tol = 1e-10 * res.rho0;
                 }
                 st = pcg_solve(&q.op, pre[v], &q.proj, bq, xq, &o, &work, &res);
