@@ -1,5 +1,5 @@
 /* PCG (SPEC 5) with block and scalar Jacobi on synthetic SPD block matrices:
- * convergence to tolerance, projection, the forcing-term stop, the cap,
+ * convergence to tolerance, projection, the forcing-term and relative stops, the cap,
  * non-positive curvature, singular diagonal blocks, determinism, and flexible
  * CG for a variable preconditioner. */
 #include <math.h>
@@ -146,6 +146,26 @@ int main(void)
         }
     }
 
+    /* 2b. relative stops: PCG_RELATIVE on the preconditioned norm (HOT's
+     * Gast15 CG), PCG_RELATIVE_L2 on the plain residual (Gast §3.1); each
+     * stops at the first iteration meeting its rule and not one earlier */
+    for (int mode = 0; mode < 2; ++mode) {
+        const double rel = 0.05;
+        PcgOptions o = {.stop = mode ? PCG_RELATIVE_L2 : PCG_RELATIVE, .rel_tol = rel, .max_iters = 10000};
+        st = pcg_solve(&p.op, bj, &p.proj, b, x, &o, &work, &res);
+        int it = res.iters;
+        double m_end = mode ? rel_residual(&p, b, x) : res.rho / res.rho0;
+        PcgOptions o2 = o;
+        o2.max_iters = it - 1;
+        PcgResult r2;
+        pcg_solve(&p.op, bj, &p.proj, b, x2, &o2, &work, &r2);
+        double m_before = mode ? rel_residual(&p, b, x2) : r2.rho / r2.rho0;
+        CHECK(st == MPM_OK && !res.capped && !res.indefinite && it >= 2 && m_end < rel && m_before >= rel,
+              "%s: %d iterations, relative measure %.4f at the end, %.4f one iteration earlier",
+              mode ? "PCG_RELATIVE_L2" : "PCG_RELATIVE", it, m_end, m_before);
+        printf("%s %.2f: %d iterations\n", mode ? "relative L2 residual" : "relative preconditioned norm", rel, it);
+    }
+
     /* 3. the cap */
     {
         PcgOptions o = {.stop = PCG_ABSOLUTE, .abs_tol = 0.0, .max_iters = 3};
@@ -173,8 +193,9 @@ int main(void)
         st = pcg_solve(&neg, NULL, &p.proj, b, x, &o, &work, &res);
         vec_copy(len, b, x2);
         projection_apply(&p.proj, x2);
-        CHECK(st == MPM_OK && res.iters == 0 && res.capped == 0 && memcmp(x, x2, sizeof(double) * len) == 0,
-              "indefinite: st %d iters %d capped %d", st, res.iters, res.capped);
+        CHECK(st == MPM_OK && res.iters == 0 && res.capped == 0 && res.indefinite &&
+                  memcmp(x, x2, sizeof(double) * len) == 0,
+              "indefinite: st %d iters %d capped %d flag %d", st, res.iters, res.capped, res.indefinite);
     }
 
     /* 6. work arrays grow: a larger problem after a smaller one */

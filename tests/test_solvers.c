@@ -82,6 +82,7 @@ typedef struct {
     double *dv;
     SolveStats st;
     int monotone;
+    int skipped; /* not judged here */
 } Outcome;
 
 /* Solves the first step with `spec` at eps; MPM_OK or the failing status
@@ -93,6 +94,14 @@ static int solve_first_step(const char *spec, double eps, Outcome *out)
     Solver *solver = NULL;
     int st = step_open(&s);
     if (!st) st = solver_from_spec(spec, NULL, 0, &solver);
+    if (!st && strcmp(solver->stop->name, "cn") != 0) {
+        /* a preset with its own stopping rule (gast15's ||g|| < tau) is
+         * judged here at the same CN accuracy as the others */
+        static const char *const cn[] = {"stop=cn"};
+        solver_destroy(solver);
+        solver = NULL;
+        st = solver_from_spec(spec, cn, 1, &solver);
+    }
     if (!st) {
         int n = s.sim.pb.n_nodes;
         out->dv = calloc(3 * (size_t)n, sizeof(double));
@@ -148,6 +157,7 @@ static int measure(Outcome *res, int np, double *e, double *r, double *cn)
         st = inv_setup(chol, &in);
     }
     for (int k = 0; k < np && !st; ++k) {
+        if (res[k].skipped) continue;
         for (size_t i = 0; i < len; ++i) w[i] = res[k].dv[i] - res[0].dv[i];
         bsr_spmv(&H, w, y);
         e[k] = sqrt(fmax(vec_dot(len, w, y), 0.0));
@@ -174,6 +184,13 @@ static void agreement(void)
     if (st) return;
     for (int k = 1; k < np; ++k) {
         const char *name = registry_preset(k - 1)->name;
+        if (!(registry_find_outer(registry_preset(k - 1)->outer)->flags & OUTER_TO_TOLERANCE)) {
+            /* one linearised solve (semi-implicit): no tolerance to agree at;
+             * tests/test_gast15.c checks it against an exact Newton step */
+            res[k].skipped = 1;
+            printf("%-14s skipped: does not iterate to a tolerance\n", name);
+            continue;
+        }
         double t0 = omp_get_wtime();
         st = solve_first_step(name, EPS, &res[k]);
         double t1 = omp_get_wtime();
@@ -193,10 +210,11 @@ static void agreement(void)
     st = measure(res, np, e, r, cn);
     CHECK(st == MPM_OK, "energy norms: %s", mpm_last_error());
     for (int k = 1; k < np; ++k)
-        CHECK(r[0] < 0.05 * r[k], "the reference is tight: |g*|_H^-1 %.3e vs %.3e of %s", r[0], r[k],
+        CHECK(res[k].skipped || r[0] < 0.05 * r[k], "the reference is tight: |g*|_H^-1 %.3e vs %.3e of %s", r[0], r[k],
               registry_preset(k - 1)->name);
     for (int k = 1; k < np && !st; ++k) {
         const char *name = registry_preset(k - 1)->name;
+        if (res[k].skipped) continue;
         CHECK(cn[k] < EPS && fabs(cn[k] - res[k].st.residual) <= 1e-12 * cn[k],
               "%s: CN residual at the returned dv %.6e, reported %.6e", name, cn[k], res[k].st.residual);
         CHECK(e[k] <= 2.0 * r[k] + r[0] && e[k] >= 0.5 * r[k] - r[0],
