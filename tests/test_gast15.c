@@ -482,11 +482,81 @@ static void first_cg(const char *spec, int projected, PcgStop mode, int rel_from
           "%s: first CG took %ld iterations, the rule (relative %.4f) %d", spec, ss.linear_iters, rel, pr.iters);
     printf("%s: first CG %ld iterations = %d of pcg to relative %.4f (||g|| %.3e)\n", spec, ss.linear_iters,
            pr.iters, rel, gn);
+    /* the floor tau_g itself: the L2 rule's tau, or the CN rule's L2 equivalent */
+    SolveCtx c = {.pb = pb, .stop = s->stop, .stop_tol = isnan(s->stop_tol) ? set.eps : s->stop_tol};
+    CHECK(solve_gradient_tolerance(&c) == tau, "%s: tau_g %.6e, expected %.6e", spec, solve_gradient_tolerance(&c), tau);
     pcg_work_free(&w);
     inv_destroy(M);
     solver_destroy(s);
     free(dv), free(g), free(x), free(D);
     fixture_free(&f);
+}
+
+/* ---- which tangent each method hands its inverse approximation ---- */
+
+static int g_probe_projected = -1, g_probe_nodes;
+static int probe_create(SolverOptions *opt, InvApprox **out);
+static int probe_setup(InvApprox *self, const InvSetupInput *in)
+{
+    (void)self;
+    g_probe_projected = in->problem->tangent_projected;
+    return MPM_OK;
+}
+static int probe_apply(InvApprox *self, const double *r, double *z)
+{
+    (void)self;
+    memcpy(z, r, sizeof(double) * 3 * (size_t)g_probe_nodes);
+    return MPM_OK;
+}
+static void probe_view(const InvApprox *self, FILE *f, InvView *out)
+{
+    (void)self, (void)f, (void)out;
+}
+static void probe_destroy(InvApprox *self) { free(self); }
+static const InvApproxOps g_probe_ops = {"probe", "records the tangent", probe_create, probe_setup, probe_apply,
+                                         probe_view, probe_destroy};
+static int probe_create(SolverOptions *opt, InvApprox **out)
+{
+    (void)opt;
+    *out = calloc(1, sizeof(InvApprox));
+    if (!*out) return MPM_EINTERNAL;
+    (*out)->ops = &g_probe_ops;
+    (*out)->caps = INV_MATRIX_FREE | INV_SYMMETRIC | INV_POSITIVE;
+    return MPM_OK;
+}
+
+/* gast15 and semi-implicit run on the unprojected tangent, pn on the projected one */
+static void tangents(void)
+{
+    const char *spec[3] = {"gast15", "semi-implicit", "pn-pcg-mf"};
+    const int want[3] = {0, 0, 1};
+    for (int k = 0; k < 3; ++k) {
+        FixtureOptions o;
+        fixture_default(&o);
+        Fixture f;
+        int st = fixture_build(&f, &o);
+        g_probe_nodes = f.pb.n_nodes;
+        double *dv = malloc(sizeof(double) * 3 * (size_t)f.pb.n_nodes);
+        Solver *s = NULL;
+        if (!st) st = solver_from_spec(spec[k], NULL, 0, &s);
+        if (!st) {
+            inv_destroy(s->inv);
+            st = inv_create(&g_probe_ops, NULL, &s->inv);
+        }
+        SolveSettings set;
+        solve_settings_default(&set);
+        set.max_outer = 1;
+        set.max_linear = 2;
+        SolveStats ss;
+        g_probe_projected = -1;
+        problem_initial_guess(&f.pb, dv);
+        if (!st) st = solver_solve(s, &f.pb, &set, dv, &ss, NULL, NULL);
+        CHECK(st == MPM_OK && g_probe_projected == want[k], "%s: inverse approximation set up on a %s tangent", spec[k],
+              g_probe_projected == 1 ? "projected" : g_probe_projected == 0 ? "unprojected" : "missing");
+        solver_destroy(s);
+        free(dv);
+        fixture_free(&f);
+    }
 }
 
 /* ---- 5. semi-implicit ---- */
@@ -603,6 +673,7 @@ int main(void)
     wolfe_steps();
     gast15_scene("stretched-box", 3.6, 1e-3);
     gast15_scene("bar3", 4.3, 1e-3);
+    tangents();
     first_cg("gast15-hot", 1, PCG_RELATIVE, 0);
     first_cg("gast15:initial_guess=given", 0, PCG_RELATIVE_L2, 0);
     first_cg("gast15:initial_guess=given,stop=cn", 0, PCG_RELATIVE_L2, 1);
