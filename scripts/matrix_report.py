@@ -14,7 +14,8 @@ table is read by column name). Writes
   DIR/figures/*.png    800 x 500 pixels each.
 
 A case is one combination of every cell column but the solver (scene, eps,
-scale, threads, frames, timed window, named axes). An overview gives every
+scale, threads, frames, timed window, named axes but "solver_setting", which
+holds per-solver settings such as a CFL number). An overview gives every
 case's s/frame per solver and the speedups against the baseline (total /
 max per frame, HOT Fig. 15); then, per case, a table of
 solvers (HOT supplement Table 1): seconds per frame over the timed window,
@@ -23,7 +24,9 @@ over the solver's) and the largest per-frame speedup (max over the timed
 frames of the baseline's frame time over the solver's), outer and linear
 iterations over the window (and linear per step, HOT Table 3), and the worst
 status (the cell's status when it did not end "ok", else the worst solve
-status of its frames). Speedups need both cells to have ended ok.
+status of its frames), the smallest and the average time step over the
+window (steps.csv dt; Gast et al. 2015 Fig. 18) and the largest CN residual
+of its frames. Speedups need both cells to have ended ok.
 
 Figures: Dolan-More performance profiles over all cases (the fraction of
 cases in which a solver's s/frame is within a factor tau of the best one; a
@@ -48,6 +51,12 @@ import sys
 FIG_W, FIG_H, DPI = 8.0, 5.0, 100  # 800 x 500 pixels
 STATUS_RANK = {"converged": 0, "capped": 1, "stalled": 2, "timeout": 3, "failed": 4}
 CASE_SKIP = {"id", "solver", "set", "solver_opts"}  # not part of a case key
+SMALL_COLUMNS = {"min_dt", "avg_dt", "max_residual"}  # written as %e in report.csv
+# A named axis called "solver_setting" holds settings that belong to a solver
+# rather than to the case (paired with solvers by include/exclude rules, e.g.
+# the semi-implicit method's own CFL number in gast15-fig18.json): it is not
+# part of the case key, so those cells are compared with the others.
+SOLVER_AXES = {"solver_setting"}
 
 
 def die(msg, code=2):
@@ -116,6 +125,14 @@ class Cell:
                 self.outer += int(number(f.get("outer_iters"), 0))
                 self.linear += int(number(f.get("linear_iters"), 0))
                 self.steps += int(number(f.get("steps"), 0))
+        self.max_residual = max((number(f.get("max_residual")) for f in frames
+                                 if int(number(f.get("frame"), -1)) >= self.first), default=float("nan"))
+        # time steps over the timed window (Gast et al. 2015 Fig. 18: min and average dt)
+        dts = [number(r.get("dt")) for r in read_csv(os.path.join(d, "steps.csv")) or []
+               if int(number(r.get("frame"), -1)) >= self.first]
+        dts = [x for x in dts if math.isfinite(x)]
+        self.min_dt = min(dts) if dts else float("nan")
+        self.avg_dt = sum(dts) / len(dts) if dts else float("nan")
         self.timed = {k: t for k, t in self.frame_time.items() if k >= self.first}
         self.timed_wall = sum(self.timed.values())
         self.s_per_frame = self.timed_wall / len(self.timed) if self.timed else float("nan")
@@ -147,7 +164,7 @@ def case_columns(cells):
     for c in cells[0].row:
         if c == "status":
             break
-        if c not in CASE_SKIP:
+        if c not in CASE_SKIP and c not in SOLVER_AXES:
             cols.append(c)
     return cols
 
@@ -493,17 +510,21 @@ def main(argv):
                     continue
                 total, per = speedups(c, base)
                 lin_step = c.linear / c.steps if c.steps else float("nan")
-                rows.append([s, c.status, len(c.timed), fmt(c.s_per_frame), fmt(total), fmt(per), fmt(c.outer),
-                             fmt(c.linear), fmt(lin_step), c.worst])
+                setting = c.row.get("solver_setting", "")
+                rows.append([f"{s} ({setting})" if setting else s, c.status, len(c.timed), fmt(c.s_per_frame), fmt(total), fmt(per), fmt(c.outer),
+                             fmt(c.linear), fmt(lin_step), c.worst, fmt(c.min_dt), fmt(c.avg_dt),
+                             fmt(c.max_residual)])
                 table_rows.append({"case": title, "scene": c.row.get("scene", ""), "solver": s, "status": c.status,
                                    "timed_frames": len(c.timed), "s_per_frame": c.s_per_frame,
                                    "speedup_total": total, "speedup_max_frame": per, "outer_iters": c.outer,
-                                   "linear_iters": c.linear, "linear_per_step": lin_step, "worst_status": c.worst})
+                                   "linear_iters": c.linear, "linear_per_step": lin_step, "worst_status": c.worst,
+                                   "min_dt": c.min_dt, "avg_dt": c.avg_dt, "max_residual": c.max_residual})
         md.append(f"### {title}\n")
         if per_scene.get(cs[0].row.get("scene", "")):
             md.append(f"({per_scene[cs[0].row.get('scene', '')]})\n")
         md.append(markdown(["solver", "status", "timed frames", "s/frame", f"speedup vs {baseline or '-'}",
-                            "max per-frame speedup", "outer", "linear", "linear/step", "worst status"], rows))
+                            "max per-frame speedup", "outer", "linear", "linear/step", "worst status", "min dt",
+                            "avg dt", "max residual"], rows))
         fp = frame_plot(plt, root, i, title, cs, order)
         if fp:
             md.append(f"\n![frame times, {title}]({fp})\n")
@@ -519,11 +540,13 @@ def main(argv):
 
     with open(os.path.join(root, "report.csv"), "w", newline="") as f:
         keys = ["case", "scene", "solver", "status", "timed_frames", "s_per_frame", "speedup_total",
-                "speedup_max_frame", "outer_iters", "linear_iters", "linear_per_step", "worst_status"]
+                "speedup_max_frame", "outer_iters", "linear_iters", "linear_per_step", "worst_status", "min_dt",
+                "avg_dt", "max_residual"]
         w = csv.DictWriter(f, fieldnames=keys)
         w.writeheader()
         for r in table_rows:
-            w.writerow({k: (f"{v:.6f}" if isinstance(v, float) and math.isfinite(v) else
+            w.writerow({k: (f"{v:.6e}" if k in SMALL_COLUMNS and isinstance(v, float) and math.isfinite(v) else
+                            f"{v:.6f}" if isinstance(v, float) and math.isfinite(v) else
                             "" if v is None or (isinstance(v, float) and not math.isfinite(v)) else v)
                         for k, v in r.items()})
     performance_profile(plt, root, cases, titles, order, md)

@@ -38,6 +38,8 @@ cell c3 toy base 1e+07 1 ok 1.0 converged "1.0 0 0 converged" "2.0 5 50 converge
 cell c4 toy fast 1e+07 1 timeout 1.0 converged "1.0 0 0 converged" "0.5 3 3 converged"
 cell c5 toy2 base 1e+05 0 ok 1.0 converged "2.0 8 80 converged"
 cell c6 toy2 fast 1e+05 0 ok 1.0 converged "1.0 9 9 converged"
+# steps.csv of one cell: dt over the timed window (frames 1-3) only
+printf 'frame,step,dt,status\n0,0,0.5,converged\n1,0,0.004,converged\n2,0,0.001,converged\n2,1,0.003,converged\n3,0,0.004,converged\n' >"$d/cells/c1/steps.csv"
 for id in c1 c2; do
   echo "frame,step,iter,elapsed_s,residual,energy" >"$d/cells/$id/iters.csv"
   for k in 0 1 2 3; do echo "1,0,$k,0.$k,1e-$((k + 3)),-1.0" >>"$d/cells/$id/iters.csv"; done
@@ -61,6 +63,10 @@ check "fast: max per-frame speedup max(4/1, 4/1, 4/2) = 4" test "$(field "toy st
 check "baseline against itself: 1" test "$(field "toy stiffness=1e+05" base speedup_total)" = "1.000000"
 check "iterations over the timed window" test "$(field "toy stiffness=1e+05" fast outer_iters),$(field "toy stiffness=1e+05" fast linear_iters)" = "60,30"
 check "linear per step (HOT Table 3): 300 / 6" test "$(field "toy stiffness=1e+05" base linear_per_step)" = "50.000000"
+check "min dt over the timed window (frame 0 not timed)" test "$(field "toy stiffness=1e+05" base min_dt)" = "1.000000e-03"
+check "average dt over the timed window: 0.012 / 4" test "$(field "toy stiffness=1e+05" base avg_dt)" = "3.000000e-03"
+check "no steps.csv: no dt" test "$(field "toy stiffness=1e+05" fast min_dt)" = ""
+check "max residual over the timed window" test "$(field "toy stiffness=1e+05" base max_residual)" = "5.000000e-08"
 check "worst status of frames" test "$(field "toy stiffness=1e+05" fast worst_status)" = capped
 check "a timed-out cell: no speedup" test "$(field "toy stiffness=1e+07" fast speedup_total)" = ""
 check "a timed-out cell: worst status timeout" test "$(field "toy stiffness=1e+07" fast worst_status)" = timeout
