@@ -229,19 +229,11 @@ static int gast15_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *
         double gTp = vec_dot(len, s->g, s->p);
         st->solve_s += omp_get_wtime() - t2;
 
-        LineSearchOutcome lr;
-        if ((status = solve_line_search(c, dv, s->g, s->p, E, gTp, s->dv_new, s->g_new, &lr, st))) return status;
-        if (lr.stalled) break;
-        vec_copy(len, s->dv_new, dv);
-        double *t = s->g;
-        s->g = s->g_new;
-        s->g_new = t;
-        E = lr.energy;
+        int stalled;
+        if ((status = solve_take_step(c, dv, &s->g, &s->g_new, s->p, &E, gTp, s->dv_new, st, &stalled))) return status;
+        if (stalled) break;
     }
-    if (H) {
-        st->hessian_blocks = H->nnzb;
-        st->hessian_bytes = bsr_bytes(H);
-    }
+    solve_hessian_stats(H, st);
     return MPM_OK;
 }
 

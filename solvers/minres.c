@@ -23,6 +23,7 @@
 
 #include "core/error.h"
 #include "core/vec.h"
+#include "solvers/pcg.h"
 
 static int minres_reserve(MinresWork *w, int n)
 {
@@ -53,13 +54,8 @@ void minres_work_free(MinresWork *w)
 static int precondition(InvApprox *M, const Projection *proj, size_t len, const double *v, double *z, int it,
                         double *gamma)
 {
-    if (M) {
-        int st = inv_apply(M, v, z);
-        if (st) return st;
-    } else {
-        vec_copy(len, v, z);
-    }
-    projection_apply(proj, z);
+    int st = precondition_projected(M, proj, len, v, z);
+    if (st) return st;
     double vz = vec_dot(len, v, z);
     if (!isfinite(vz) || vz < 0.0)
         return mpm_error(MPM_ENUMERIC, "minres: v^T M^-1 v = %g at iteration %d (preconditioner not SPD?)", vz, it);
@@ -84,7 +80,7 @@ int minres_solve(const LinearOp *A, InvApprox *M, const Projection *proj, const 
     vec_zero(len, w);
     vec_copy(len, b, v);
     projection_apply(proj, v);
-    double gamma;
+    double gamma = 0.0;
     if ((st = precondition(M, proj, len, v, z, 0, &gamma))) return st;
     res->res0 = res->res = gamma;
     if (gamma == 0.0) return MPM_OK; /* b is zero in the free subspace */
@@ -110,7 +106,7 @@ int minres_solve(const LinearOp *A, InvApprox *M, const Projection *proj, const 
         const double f1 = delta / gamma, f0 = gamma / gamma_prev;
 #pragma omp parallel for schedule(static)
         for (size_t k = 0; k < len; ++k) v_prev[k] = q[k] - f1 * v[k] - f0 * v_prev[k];
-        double gamma_next;
+        double gamma_next = 0.0;
         ++it;
         if ((st = precondition(M, proj, len, v_prev, z_next, it, &gamma_next))) {
             res->iters = it;

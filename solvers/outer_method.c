@@ -141,6 +141,28 @@ int solve_line_search(SolveCtx *c, const double *dv, const double *g, const doub
     return status;
 }
 
+int solve_take_step(SolveCtx *c, double *dv, double **g, double **g_new, const double *p, double *E, double gTp,
+                    double *dv_new, SolveStats *st, int *stalled)
+{
+    LineSearchOutcome lr;
+    int status = solve_line_search(c, dv, *g, p, *E, gTp, dv_new, *g_new, &lr, st);
+    *stalled = status == MPM_OK && lr.stalled;
+    if (status || lr.stalled) return status;
+    vec_copy(3 * (size_t)c->pb->n_nodes, dv_new, dv);
+    double *t = *g;
+    *g = *g_new;
+    *g_new = t;
+    *E = lr.energy;
+    return MPM_OK;
+}
+
+void solve_hessian_stats(const Bsr *H, SolveStats *st)
+{
+    if (!H) return;
+    st->hessian_blocks = H->nnzb;
+    st->hessian_bytes = bsr_bytes(H);
+}
+
 void solve_keep_dirichlet(const StepProblem *pb, const double *dv, const double *free_part, double *out, double *tmp)
 {
     const size_t len = 3 * (size_t)pb->n_nodes;

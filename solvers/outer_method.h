@@ -159,6 +159,14 @@ int solve_line_search(SolveCtx *c, const double *dv, const double *g, const doub
  * free subspace (P the BC projection); out may alias free but not dv, tmp (3n) is
  * scratch. For initial guesses and linearisation points other than dv. */
 void solve_keep_dirichlet(const StepProblem *pb, const double *dv, const double *free_part, double *out, double *tmp);
+/* solve_line_search along p from *dv, then, unless it stalled, the step:
+ * dv = dv_new, *g and *g_new swapped (g holds the new gradient), *E the new
+ * energy. Returns the line search's status; *stalled = 1 ends the solve
+ * (st->status says why). */
+int solve_take_step(SolveCtx *c, double *dv, double **g, double **g_new, const double *p, double *E, double gTp,
+                    double *dv_new, SolveStats *st, int *stalled);
+/* Hessian storage statistics of an assembled H (nothing when NULL). */
+void solve_hessian_stats(const Bsr *H, SolveStats *st);
 /* Grows vecs[k] to per_node[k] doubles per node for n nodes, k < count
  * (capacity in nodes kept in *cap, grown with headroom). */
 int solve_reserve(double **const *vecs, const size_t *per_node, int count, int n, int *cap);

@@ -63,8 +63,7 @@ void pcg_work_free(PcgWork *w)
     w->cap_nodes = 0;
 }
 
-/* z = P(M^-1 r); M == NULL is the identity. */
-static int precondition(InvApprox *M, const Projection *proj, size_t len, const double *r, double *z)
+int precondition_projected(InvApprox *M, const Projection *proj, size_t len, const double *r, double *z)
 {
     if (M) {
         int st = inv_apply(M, r, z);
@@ -94,7 +93,7 @@ int pcg_solve(const LinearOp *A, InvApprox *M, const Projection *proj, const dou
     vec_zero(len, x);
     vec_copy(len, b, r);
     projection_apply(proj, r);
-    st = precondition(M, proj, len, r, z);
+    st = precondition_projected(M, proj, len, r, z);
     if (st) return st;
     double rz = vec_dot(len, r, z);
     if (!isfinite(rz)) return mpm_error(MPM_ENUMERIC, "pcg: non-finite initial residual (r^T M^-1 r = %g)", rz);
@@ -144,7 +143,7 @@ int pcg_solve(const LinearOp *A, InvApprox *M, const Projection *proj, const dou
         double alpha = rz / pq;
         vec_axpy(len, alpha, p, x);
         vec_axpy(len, -alpha, q, r);
-        st = precondition(M, proj, len, r, z);
+        st = precondition_projected(M, proj, len, r, z);
         if (st) return st;
         double rz_new = vec_dot(len, r, z);
         ++it;

@@ -54,5 +54,8 @@ typedef struct {
 int pcg_solve(const LinearOp *A, InvApprox *M, const Projection *proj, const double *b, double *x,
               const PcgOptions *opt, PcgWork *work, PcgResult *res);
 void pcg_work_free(PcgWork *w);
+/* z = P(M^-1 r) over len entries (M == NULL: the identity), the
+ * preconditioning step of pcg_solve and minres_solve. */
+int precondition_projected(InvApprox *M, const Projection *proj, size_t len, const double *r, double *z);
 
 #endif

@@ -144,10 +144,7 @@ static int si_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *st)
         st->status = SOLVE_CONVERGED;
         st->reason[0] = '\0';
     }
-    if (H) {
-        st->hessian_blocks = H->nnzb;
-        st->hessian_bytes = bsr_bytes(H);
-    }
+    solve_hessian_stats(H, st);
     return MPM_OK;
 }
 

@@ -67,3 +67,21 @@ void fixture_free(Fixture *f)
     stencils_free(&f->st);
     particles_free(&f->p);
 }
+
+int scene_step_open(SceneStep *s, const char *scene, double scale)
+{
+    memset(s, 0, sizeof *s);
+    SceneLoadOptions lo = {scale, NULL, 0, NULL};
+    int st = scene_load(scene, &lo, &s->sc);
+    if (st) return st;
+    s->loaded = 1;
+    if ((st = sim_init(&s->sim, &s->sc))) return st;
+    s->started = 1;
+    return step_begin(&s->sim);
+}
+
+void scene_step_close(SceneStep *s)
+{
+    if (s->started) sim_free(&s->sim);
+    if (s->loaded) scene_free(&s->sc);
+}

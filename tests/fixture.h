@@ -6,6 +6,7 @@
 
 #include "core/grid.h"
 #include "core/problem.h"
+#include "core/step.h"
 
 typedef struct {
     Particles p;
@@ -29,6 +30,16 @@ typedef struct {
     double gravity[3];
     unsigned long long seed;
 } FixtureOptions;
+
+/* The first step problem of a built-in scene (or scene file) at --scale,
+ * ready for a solve (step_begin done). Close it whatever open returned. */
+typedef struct {
+    Scene sc;
+    Simulation sim;
+    int loaded, started;
+} SceneStep;
+int scene_step_open(SceneStep *s, const char *scene, double scale);
+void scene_step_close(SceneStep *s);
 
 void fixture_default(FixtureOptions *o);
 int fixture_build(Fixture *f, const FixtureOptions *o);

@@ -52,6 +52,20 @@
 static void spmv_op(const void *ctx, const double *x, double *y) { bsr_spmv((const Bsr *)ctx, x, y); }
 static void project_op(const void *ctx, double *v) { problem_project((const StepProblem *)ctx, v); }
 
+/* CHOLMOD set up on the true (unprojected, BC-projected) Hessian at the
+ * problem's cached iterate: H assembled into *H, diagonal scratch D (9n) */
+static int factor_true_hessian(StepProblem *pb, Bsr *H, double *D, InvApprox *chol)
+{
+    int st = problem_tangent(pb, 0);
+    if (!st) st = problem_assemble(pb, H);
+    if (st) return st;
+    bsr_diagonal(H, D);
+    LinearOp op = {pb->n_nodes, spmv_op, H};
+    Projection proj = {project_op, pb};
+    InvSetupInput in = {.n_nodes = pb->n_nodes, .H = H, .diag = D, .op = &op, .proj = &proj};
+    return inv_setup(chol, &in);
+}
+
 /* ---- 1. gast-diagonal ---- */
 
 static void rest_diagonal(void)
@@ -229,30 +243,6 @@ static int checked_wolfe(StepProblem *pb, const double *dv, const double *p, dou
     return MPM_OK;
 }
 
-typedef struct {
-    Scene sc;
-    Simulation sim;
-    int loaded, started;
-} Step;
-
-static int step_open(Step *s, const char *scene, double scale)
-{
-    memset(s, 0, sizeof *s);
-    SceneLoadOptions lo = {scale, NULL, 0, NULL};
-    int st = scene_load(scene, &lo, &s->sc);
-    if (st) return st;
-    s->loaded = 1;
-    if ((st = sim_init(&s->sim, &s->sc))) return st;
-    s->started = 1;
-    return step_begin(&s->sim);
-}
-
-static void step_close(Step *s)
-{
-    if (s->started) sim_free(&s->sim);
-    if (s->loaded) scene_free(&s->sc);
-}
-
 /* p = -P M^-1 g at dv0 times `scale`, alpha from the Wolfe search */
 static void wolfe_alpha(StepProblem *pb, double scale, double *alpha_out, int *ok_out)
 {
@@ -280,8 +270,8 @@ static void wolfe_alpha(StepProblem *pb, double scale, double *alpha_out, int *o
 
 static void wolfe_steps(void)
 {
-    Step s;
-    int st = step_open(&s, "stretched-box", 3.6);
+    SceneStep s;
+    int st = scene_step_open(&s, "stretched-box", 3.6);
     CHECK(st == MPM_OK, "stretched-box: %s", mpm_last_error());
     if (!st) {
         /* the mass-scaled gradient step, the steepest descent direction of
@@ -296,7 +286,7 @@ static void wolfe_steps(void)
         CHECK(ok_long && a_long < 1.0, "long direction: alpha %g, strong Wolfe %d", a_long, ok_long);
         printf("strong Wolfe: alpha %g on a short direction, %g on a long one\n", a_short, a_long);
     }
-    step_close(&s);
+    scene_step_close(&s);
 }
 
 typedef struct {
@@ -315,8 +305,8 @@ static void gast15_scene(const char *scene, double scale, double tau)
 {
     char spec[96];
     snprintf(spec, sizeof spec, "gast15:tau=%g,max_step=%g", tau, 5.0);
-    Step s;
-    int st = step_open(&s, scene, scale);
+    SceneStep s;
+    int st = scene_step_open(&s, scene, scale);
     CHECK(st == MPM_OK, "%s: %s", scene, mpm_last_error());
     Solver *gs = NULL, *ref = NULL;
     if (!st) st = solver_from_spec(spec, NULL, 0, &gs);
@@ -324,7 +314,7 @@ static void gast15_scene(const char *scene, double scale, double tau)
     CHECK(st == MPM_OK, "%s: solvers: %s", scene, mpm_last_error());
     if (st) {
         solver_destroy(gs);
-        step_close(&s);
+        scene_step_close(&s);
         return;
     }
     StepProblem *pb = &s.sim.pb;
@@ -381,16 +371,8 @@ static void gast15_scene(const char *scene, double scale, double tau)
     Bsr H = {0};
     InvApprox *chol = NULL;
     problem_energy(pb, dvr);
-    if (!st) st = problem_tangent(pb, 0);
-    if (!st) st = problem_assemble(pb, &H);
     if (!st) st = inv_create(registry_find_inverse("cholmod"), NULL, &chol);
-    LinearOp op = {n, spmv_op, &H};
-    Projection proj = {project_op, pb};
-    if (!st) {
-        bsr_diagonal(&H, D);
-        InvSetupInput in = {.n_nodes = n, .H = &H, .diag = D, .op = &op, .proj = &proj};
-        st = inv_setup(chol, &in);
-    }
+    if (!st) st = factor_true_hessian(pb, &H, D, chol);
     CHECK(st == MPM_OK, "%s: CHOLMOD on the true Hessian at dv*: %s", scene, mpm_last_error());
     if (!st) {
         double rstar, r, gm, e;
@@ -422,7 +404,7 @@ static void gast15_scene(const char *scene, double scale, double tau)
     solver_destroy(gs);
     solver_destroy(ref);
     free(dv), free(dvr), free(g), free(w), free(y), free(t), free(D);
-    step_close(&s);
+    scene_step_close(&s);
 }
 
 /* ---- the CG tolerances of gast15 and gast15-hot ---- */
@@ -600,15 +582,7 @@ static void semi_implicit(void)
         else vec_copy(len, dv0, lin);
         problem_energy(pb, lin);
         problem_gradient(pb, lin, g);
-        st = problem_tangent(pb, 0);
-        if (!st) st = problem_assemble(pb, &H);
-        LinearOp op = {n, spmv_op, &H};
-        Projection proj = {project_op, pb};
-        if (!st) {
-            bsr_diagonal(&H, D);
-            InvSetupInput in = {.n_nodes = n, .H = &H, .diag = D, .op = &op, .proj = &proj};
-            st = inv_setup(chol, &in);
-        }
+        st = factor_true_hessian(pb, &H, D, chol);
         if (!st) {
             vec_scale(len, -1.0, g);
             st = inv_apply(chol, g, p);

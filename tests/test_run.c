@@ -103,7 +103,7 @@ static void spec_check(void)
         {"pn-gmgpcg:embedding=quadratic", "has no option 'embedding'"},
         {"pn:mg:levels=x", "levels=x: expected a number"},
         {"pn:mg:", "empty option list"},
-        {"pn-pcg:linesearch=wolfe", "linesearch=wolfe: unknown line search"},
+        {"pn-pcg:linesearch=goldstein", "linesearch=goldstein: unknown line search"},
         {"pn-pcg:stop=l2,tau=-1", "tau=-1: expected a positive number"},
         {"pn-pcg:stall_iters=0", "stall_iters=0: expected an integer"},
         {"", "expected a preset name"},

@@ -32,6 +32,7 @@
 #include "core/step.h"
 #include "core/vec.h"
 #include "experiments/registry.h"
+#include "tests/fixture.h"
 #include "tests/testutil.h"
 
 #define SCENE "twist"
@@ -53,30 +54,9 @@ static void trace_hook(void *ctx, int iter, double elapsed, double residual, dou
     t->last = energy;
 }
 
-typedef struct {
-    Scene sc;
-    Simulation sim;
-    int loaded, started;
-} Step;
-
-/* The first step problem of the scene, ready for a solve. */
-static int step_open(Step *s)
-{
-    memset(s, 0, sizeof *s);
-    SceneLoadOptions lo = {SCALE, NULL, 0, NULL};
-    int st = scene_load(SCENE, &lo, &s->sc);
-    if (st) return st;
-    s->loaded = 1;
-    if ((st = sim_init(&s->sim, &s->sc))) return st;
-    s->started = 1;
-    return step_begin(&s->sim);
-}
-
-static void step_close(Step *s)
-{
-    if (s->started) sim_free(&s->sim);
-    if (s->loaded) scene_free(&s->sc);
-}
+typedef SceneStep Step;
+static int step_open(Step *s) { return scene_step_open(s, SCENE, SCALE); }
+static void step_close(Step *s) { scene_step_close(s); }
 
 typedef struct {
     double *dv;
