@@ -28,7 +28,8 @@ static void usage(FILE *f)
             "  mpmbench render --scene NAME|FILE [--frame N] [--out FILE.png] [--solver NAME] [--scale S] [--set key=value ...]\n"
             "               [--view front|side|top|iso] [--color material|speed] [--width W] [--height H] [--asset-dir DIR] [--threads T]\n"
             "  mpmbench matrix run FILE [--out DIR] [--only GLOB ...] [--dry-run] [--jobs N] [--threads T] [--asset-dir DIR]\n"
-            "               (under mpirun -np K: the cells spread over K ranks; --check: reserved)\n"
+            "               [--check]  (under mpirun -np K: the cells spread over K ranks; --check: pass/fail\n"
+            "               per cell into DIR/check.csv, exit 1 when a cell failed)\n"
             "  mpmbench matrix report DIR     (DIR/report.md and PNGs from a matrix run)\n");
 }
 
