@@ -35,6 +35,15 @@ and against iterations for the cells run with history (first step of the
 first timed frame, HOT Figs. 16/17). With report.mg_levels in the matrix,
 also blocks per row per multigrid level (HOT Fig. 8) from mg_levels.csv.
 
+Accuracy (matrix_report_accuracy.py, beside this file): for cells run with
+error_ref or against a reference run, work-precision diagrams (wall time
+against the median per-step err_h and against the last frame's pos_rms, one
+PNG per case without eps, one line per solver), the time to reach err_h <=
+1e-4 / 1e-6 interpolated along eps, performance profiles at matched
+accuracy and wp.csv; with DIR/check.csv (matrix run --check) the case x
+solver pass/fail grid. Reference-run cells (cells.csv role "reference") are
+listed on their own, not as solvers of the cases.
+
 Exit status: 0, 2 for a directory without cells.csv/matrix.json, 1 when
 matplotlib is missing.
 """
@@ -47,7 +56,7 @@ import sys
 
 FIG_W, FIG_H, DPI = 8.0, 5.0, 100  # 800 x 500 pixels
 STATUS_RANK = {"converged": 0, "capped": 1, "stalled": 2, "timeout": 3, "failed": 4}
-CASE_SKIP = {"id", "solver", "set", "solver_opts"}  # not part of a case key
+CASE_SKIP = {"id", "solver", "set", "solver_opts", "role", "reference"}  # not part of a case key
 
 
 def die(msg, code=2):
@@ -450,6 +459,8 @@ def main(argv):
     except ImportError:
         die(f"{sys.executable} has no matplotlib (Debian: apt-get install python3-matplotlib)", 1)
     baseline = meta.get("baseline") or ""
+    references = [c for c in cells if c.row.get("role") == "reference"]
+    cells = [c for c in cells if c.row.get("role") != "reference"]
     cols = case_columns(cells)
     show = varying(cells, cols)
     cases = group_cases(cells, cols)
@@ -528,6 +539,17 @@ def main(argv):
                         for k, v in r.items()})
     performance_profile(plt, root, cases, titles, order, md)
     stiffness_plots(plt, root, cells, cols, meta, order, md)
+    import matrix_report_accuracy as accuracy
+    helpers = {"fmt": fmt, "markdown": markdown, "slug": slug, "save": save, "new_figure": new_figure,
+               "case_title": case_title, "varying": varying}
+    accuracy.work_precision(plt, root, cells, cols, order, md, helpers)
+    accuracy.robustness(plt, root, md, order, helpers)
+    if references:
+        md.append("\n## Reference runs\n")
+        md.append("The runs the cells' trajectories are compared with (their dt sequence is replayed):\n")
+        md.append(markdown(["id", "scene", "solver", "eps", "status", "frames", "s/frame"],
+                           [(c.id, c.row.get("scene", ""), c.solver, c.row.get("eps", ""), c.status,
+                             len(c.frame_time), fmt(c.s_per_frame)) for c in references]))
     with open(os.path.join(root, "report.md"), "w") as f:
         f.write("\n".join(md) + "\n")
     print(f"wrote {root}/report.md, report.csv, profile.csv and {root}/figures/")
