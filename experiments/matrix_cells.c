@@ -2,6 +2,7 @@
  * (matrix_cells.h). */
 #include "experiments/matrix_cells.h"
 
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -558,7 +559,8 @@ int matrix_cell_argv(const Matrix *m, const MatrixCell *c, const char *out_dir, 
     const char *sec_flags[2] = {"--max-step-seconds", "--max-run-seconds"};
     for (int k = 0; k < 2; ++k) {
         if (!(secs[k] > 0)) continue;
-        matrix_format_number(secs[k], num, sizeof num);
+        if (secs[k] == floor(secs[k])) snprintf(num, sizeof num, "%.0f", secs[k]); /* 30, not 3e+01 */
+        else matrix_format_number(secs[k], num, sizeof num);
         st |= push_arg(buf, cap, &used, argc, "%s%s", sec_flags[k], "");
         st |= push_arg(buf, cap, &used, argc, "%s%s", num, "");
     }
