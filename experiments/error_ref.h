@@ -14,8 +14,10 @@
  * SPEC is SOLVER[:eps] with SOLVER a solver spec (registry.h) or "auto" and
  * eps the reference's CN tolerance (default 1e-12). "auto" takes pn-cholmod
  * (exact Newton) at the steps whose factor fits the memory budget and
- * pn-pcg at the others (error_ref_cholmod_fits), each step saying which in
- * steps.csv's ref_solver. The reference solve and the metrics run inside
+ * pn-pcg at the others (error_ref_cholmod_fits), and at a step whose
+ * CHOLMOD factorisation breaks down (one line on stderr says so), each step
+ * saying which in steps.csv's ref_solver. Against a reference that failed
+ * the metrics are empty (ref_status failed). The reference solve and the metrics run inside
  * run_step's after-solve hook, whose time goes to no timing column (it is
  * ref_s); the problem's iterate cache is left at dv afterwards. */
 #ifndef MPM_ERROR_REF_H
