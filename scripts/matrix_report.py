@@ -229,6 +229,36 @@ def save(fig, root, name):
     return path
 
 
+def profile_figure(plt, ratios, order):
+    """The step curves rho_s(tau) of a Dolan-More profile from {solver: [ratios]} (inf = never),
+    on a log2 tau axis; (None, None) with fewer than two solvers or no finite ratio."""
+    finite = [r for rs in ratios.values() for r in rs if math.isfinite(r)]
+    if len(order) < 2 or not finite:
+        return None, None
+    tau_max = max(2.0, max(finite) * 1.1)
+    fig, ax = new_figure(plt)
+    for s in order:
+        rs = sorted(ratios.get(s, []))
+        n = len(rs)
+        if not n:
+            continue
+        xs, ys = [1.0], [0.0]
+        for i, r in enumerate(rs):
+            if not math.isfinite(r):
+                break
+            xs += [r, r]
+            ys += [ys[-1], (i + 1) / n]
+        xs.append(tau_max)
+        ys.append(ys[-1])
+        ax.plot(xs, ys, label=s, lw=1.6)
+    ax.set_xscale("log", base=2)
+    ax.set_xlim(1.0, tau_max)
+    from matplotlib.ticker import ScalarFormatter
+    ax.xaxis.set_major_formatter(ScalarFormatter())
+    ax.set_ylim(0.0, 1.02)
+    return fig, ax
+
+
 def performance_profile(plt, root, cases, titles, order, md):
     """Dolan & More (2002): rho_s(tau) = share of cases with t_s <= tau * min_s t_s."""
     ratios = {s: [] for s in order}
@@ -247,30 +277,9 @@ def performance_profile(plt, root, cases, titles, order, md):
         w.writerow(["case", "solver", "ratio"])
         for case, s, r in rows:
             w.writerow([case, s, f"{r:.6f}" if math.isfinite(r) else "inf"])
-    finite = [r for rs in ratios.values() for r in rs if math.isfinite(r)]
-    if len(order) < 2 or not finite:
+    fig, ax = profile_figure(plt, ratios, order)
+    if fig is None:
         return
-    tau_max = max(2.0, max(finite) * 1.1)
-    fig, ax = new_figure(plt)
-    for s in order:
-        rs = sorted(ratios[s])
-        n = len(rs)
-        if not n:
-            continue
-        xs, ys = [1.0], [0.0]
-        for i, r in enumerate(rs):
-            if not math.isfinite(r):
-                break
-            xs += [r, r]
-            ys += [ys[-1], (i + 1) / n]
-        xs.append(tau_max)
-        ys.append(ys[-1])
-        ax.plot(xs, ys, label=s, lw=1.6)
-    ax.set_xscale("log", base=2)
-    ax.set_xlim(1.0, tau_max)
-    from matplotlib.ticker import ScalarFormatter
-    ax.xaxis.set_major_formatter(ScalarFormatter())
-    ax.set_ylim(0.0, 1.02)
     ax.set_xlabel("tau (s/frame within a factor tau of the best)")
     ax.set_ylabel("fraction of cases")
     ax.set_title(f"Performance profile over {len(cases)} cases")
@@ -541,7 +550,7 @@ def main(argv):
     stiffness_plots(plt, root, cells, cols, meta, order, md)
     import matrix_report_accuracy as accuracy
     helpers = {"fmt": fmt, "markdown": markdown, "slug": slug, "save": save, "new_figure": new_figure,
-               "case_title": case_title, "varying": varying}
+               "case_title": case_title, "varying": varying, "profile_figure": profile_figure}
     accuracy.work_precision(plt, root, cells, cols, order, md, helpers)
     accuracy.robustness(plt, root, md, order, helpers)
     if references:

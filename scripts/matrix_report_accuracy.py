@@ -99,7 +99,7 @@ def _fmt_time(t, mark, fmt):
     return f"{mark} {fmt(t)}".strip()
 
 
-def _profile(plt, root, save, problems, order, md, new_figure):
+def _profile(plt, root, problems, order, md, helpers):
     """problems: {(case, target): {solver: time or inf}}; Dolan & More at matched accuracy."""
     ratios = {s: [] for s in order}
     rows = []
@@ -117,40 +117,30 @@ def _profile(plt, root, save, problems, order, md, new_figure):
         w.writerow(["case", "target_err_h", "solver", "ratio"])
         for case, target, s, r in rows:
             w.writerow([case, f"{target:g}", s, f"{r:.6f}" if math.isfinite(r) else "inf"])
-    finite = [r for rs in ratios.values() for r in rs if math.isfinite(r)]
-    if len(order) < 2 or not finite:
+    fig, ax = helpers["profile_figure"](plt, ratios, order)
+    if fig is None:
         return
-    tau_max = max(2.0, max(finite) * 1.1)
-    fig, ax = new_figure(plt)
-    for s in order:
-        rs = sorted(ratios[s])
-        n = len(rs)
-        if not n:
-            continue
-        xs, ys = [1.0], [0.0]
-        for i, r in enumerate(rs):
-            if not math.isfinite(r):
-                break
-            xs += [r, r]
-            ys += [ys[-1], (i + 1) / n]
-        xs.append(tau_max)
-        ys.append(ys[-1])
-        ax.plot(xs, ys, label=s, lw=1.6)
-    ax.set_xscale("log", base=2)
-    ax.set_xlim(1.0, tau_max)
-    ax.set_ylim(0.0, 1.02)
     ax.set_xlabel("tau (time to the target err_h within a factor tau of the best)")
     ax.set_ylabel("fraction of (case, target) problems")
     ax.set_title(f"Performance profile at matched accuracy ({len(problems)} problems: err_h <= "
                  + ", ".join(f"{t:g}" for t in TARGETS) + ")", fontsize=9)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="lower right")
-    path = save(fig, root, "profile_accuracy.png")
+    path = helpers["save"](fig, root, "profile_accuracy.png")
     plt.close(fig)
     md.append("\n### Performance profile at matched accuracy\n")
     md.append("Each (case, target err_h) is a problem; a solver's cost is its time to reach the target "
               "(not reached: never within any factor).\n")
     md.append(f"![performance profile at matched accuracy]({path})\n")
+
+
+def _per_eps_table(lines, eps_values, value, fmt, markdown):
+    """One row per solver, one column per eps: value(cell), "-" where the solver has no cell."""
+    rows = []
+    for s, pts in lines.items():
+        by_eps = {_num(c.row.get("eps")): c for c in pts}
+        rows.append([s] + [fmt(value(by_eps[e])) if e in by_eps else "-" for e in eps_values])
+    return markdown(["solver"] + [f"eps {e:g}" for e in eps_values], rows)
 
 
 def work_precision(plt, root, cells, cols, order, md, helpers):
@@ -188,19 +178,11 @@ def work_precision(plt, root, cells, cols, order, md, helpers):
             continue
         md.append(f"### {title}\n")
         eps_values = sorted({_num(c.row.get("eps")) for c in cs}, reverse=True)
-        rows = []
-        for s, pts in lines.items():
-            by_eps = {_num(c.row.get("eps")): c for c in pts}
-            rows.append([s] + [fmt(by_eps[e].err_h) if e in by_eps else "-" for e in eps_values])
         md.append("Median err_h per eps:\n")
-        md.append(markdown(["solver"] + [f"eps {e:g}" for e in eps_values], rows))
+        md.append(_per_eps_table(lines, eps_values, lambda c: c.err_h, fmt, markdown))
         if any(math.isfinite(c.pos_rms) for c in cs):
-            rows = []
-            for s, pts in lines.items():
-                by_eps = {_num(c.row.get("eps")): c for c in pts}
-                rows.append([s] + [fmt(by_eps[e].pos_rms) if e in by_eps else "-" for e in eps_values])
             md.append("\nLast frame's pos_rms (dx) per eps:\n")
-            md.append(markdown(["solver"] + [f"eps {e:g}" for e in eps_values], rows))
+            md.append(_per_eps_table(lines, eps_values, lambda c: c.pos_rms, fmt, markdown))
         rows = []
         for s, pts in lines.items():
             line = [s]
@@ -247,7 +229,7 @@ def work_precision(plt, root, cells, cols, order, md, helpers):
             w.writerow([f"{x:.9g}" if isinstance(x, float) and math.isfinite(x) else
                         "" if isinstance(x, float) else x for x in r])
     if problems:
-        _profile(plt, root, save, problems, order, md, new_figure)
+        _profile(plt, root, problems, order, md, helpers)
 
 
 def robustness(plt, root, md, order, helpers):

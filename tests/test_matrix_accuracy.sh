@@ -19,6 +19,9 @@ for r in csv.DictReader(open(sys.argv[1])):
         print(r[sys.argv[2]])
 PY
 }
+after() { # file-a file-b: a was last written after b (nanoseconds)
+  python3 -c "import os, sys; sys.exit(not os.stat(sys.argv[1]).st_mtime_ns >= os.stat(sys.argv[2]).st_mtime_ns)" "$1" "$2"
+}
 cat >"$tmp/m.json" <<'EOF'
 {"name": "acc",
  "defaults": {"threads": 1, "error_ref": "pn-pcg:1e-10", "max_outer": 500, "max_step_seconds": 30, "on_failure": "continue"},
@@ -49,7 +52,7 @@ for id in $(col "$csv" id scene bar3); do
   check "$id: --dt-from and --trajectory-ref the reference" grep -q -- "--dt-from $tmp/r/cells/$ref --trajectory-ref $tmp/r/cells/$ref" "$d/$id/cmd.txt"
   check "$id: its dt are the reference's" test "$(col "$d/$id/steps.csv" dt)" = "$(col "$d/$ref/steps.csv" dt)"
   check "$id: trajectory error at every frame" test "$(col "$d/$id/frames.csv" pos_rms | grep -c 'e')" -eq 2
-  check "$id: started after the reference ended" test "$(stat -c %Y "$d/$id/cmd.txt")" -ge "$(stat -c %Y "$d/$ref/frames.csv")"
+  check "$id: started after the reference ended" after "$d/$id/cmd.txt" "$d/$ref/frames.csv"
 done
 for id in $(col "$csv" id scene drop); do
   check "$id: no reference flags" bash -c "! grep -q -- '--dt-from' '$d/$id/cmd.txt'"
@@ -107,7 +110,7 @@ if command -v mpirun >/dev/null; then
   m="$tmp/mpi/cells"
   for id in $(col "$tmp/mpi/cells.csv" id scene bar3); do
     [ "$id" = "$ref" ] && continue
-    check "mpirun $id: started after the reference ended" test "$(stat -c %Y "$m/$id/cmd.txt")" -ge "$(stat -c %Y "$m/$ref/frames.csv")"
+    check "mpirun $id: started after the reference ended" after "$m/$id/cmd.txt" "$m/$ref/frames.csv"
     check "mpirun $id: the reference's dt" test "$(col "$m/$id/steps.csv" dt)" = "$(col "$m/$ref/steps.csv" dt)"
   done
 fi
