@@ -548,6 +548,7 @@ def main(argv):
                         for k, v in r.items()})
     performance_profile(plt, root, cases, titles, order, md)
     stiffness_plots(plt, root, cells, cols, meta, order, md)
+    sys.dont_write_bytecode = True  # no __pycache__ in the source tree
     import matrix_report_accuracy as accuracy
     helpers = {"fmt": fmt, "markdown": markdown, "slug": slug, "save": save, "new_figure": new_figure,
                "case_title": case_title, "varying": varying, "profile_figure": profile_figure}
