@@ -27,7 +27,10 @@ int particles_reserve(Particles *p, size_t cap)
     st |= grow((void **)&p->vol, sizeof(double), c);
     st |= grow((void **)&p->mat, sizeof(int), c);
     if (p->Jp) st |= grow((void **)&p->Jp, sizeof(double), c);
+    st |= grow((void **)&p->id, sizeof(size_t), c);
     if (st) return MPM_EINTERNAL;
+    /* defined values for particles filled without particles_push (multigrid levels) */
+    memset(p->id + p->cap, 0, sizeof(size_t) * (c - p->cap));
     p->cap = c;
     return MPM_OK;
 }
@@ -47,6 +50,7 @@ int particles_push(Particles *p, const double x[3], const double v[3], double ma
     p->vol[k] = vol;
     p->mat[k] = mat;
     if (p->Jp) p->Jp[k] = 1.0;
+    p->id[k] = k;
     return MPM_OK;
 }
 
@@ -64,6 +68,7 @@ int particles_copy(Particles *dst, const Particles *src)
     memcpy(dst->vol, src->vol, sizeof(double) * n);
     memcpy(dst->mat, src->mat, sizeof(int) * n);
     if (src->Jp) memcpy(dst->Jp, src->Jp, sizeof(double) * n);
+    memcpy(dst->id, src->id, sizeof(size_t) * n);
     dst->n = n;
     return MPM_OK;
 }
@@ -96,6 +101,10 @@ void particles_permute(Particles *p, const size_t *perm, double *scratch)
     int *mi = (int *)scratch;
     for (size_t k = 0; k < n; ++k) mi[k] = p->mat[perm[k]];
     memcpy(p->mat, mi, n * sizeof(int));
+    if (!p->id) return;
+    size_t *ids = (size_t *)scratch;
+    for (size_t k = 0; k < n; ++k) ids[k] = p->id[perm[k]];
+    memcpy(p->id, ids, n * sizeof(size_t));
 }
 
 void particles_free(Particles *p)
@@ -108,5 +117,6 @@ void particles_free(Particles *p)
     free(p->vol);
     free(p->mat);
     free(p->Jp);
+    free(p->id);
     memset(p, 0, sizeof *p);
 }

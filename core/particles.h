@@ -15,11 +15,14 @@ typedef struct {
     double *vol;  /* n rest volumes [m^3] */
     int *mat;     /* n material index into the scene's materials */
     double *Jp;   /* n plastic volume ratio (snow hardening); NULL unless a material needs it */
+    size_t *id;   /* n identities: the particle's index when it was pushed (0, 1, ...; particles are
+                     never removed), kept through particles_permute and particles_copy, so runs
+                     can be compared particle by particle (experiments/trajectory.h) */
 } Particles;
 
 /* Grows capacity to at least `cap` (keeps contents). */
 int particles_reserve(Particles *p, size_t cap);
-/* Appends one particle with F = I, C = 0. */
+/* Appends one particle with F = I, C = 0, id = its index. */
 int particles_push(Particles *p, const double x[3], const double v[3], double mass, double vol, int mat);
 /* Allocates the plastic state array (Jp = 1) if absent. */
 int particles_enable_plastic_state(Particles *p);

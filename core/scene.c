@@ -120,7 +120,7 @@ static const char *const k_mat_optional[] = {"plasticity", NULL};
 static const char *const k_plast_optional[] = {"yield_stress", "theta_c", "theta_s", "hardening",
                                                "min_Jp",       "max_Jp",  NULL};
 static const char *const k_obj_optional[] = {"name",      "sampling",          "velocity", "initial_F",
-                                             "variation", "surface_particles", NULL};
+                                             "variation", "surface_particles", "stiffness_variation", NULL};
 static const char *const k_col_optional[] = {"name",        "type",              "pivot",     "motion",
                                              "oscillation", "material_velocity", "cfl_speed", "friction", NULL};
 static const char *const k_src_optional[] = {"name",        "from",     "until",           "pivot", "motion",
@@ -314,6 +314,14 @@ typedef struct {
     double F_min, F_max;
     uint64_t F_seed;
     int F_per_particle;
+    int F_fixed;            /* "type": "diagonal": F = diag(F_values) */
+    double F_values[3];
+    double F_inverted;      /* "inverted_fraction": share of particles with d0 negated (det F < 0) */
+    int has_stiffness_var;  /* "stiffness_variation": some particles get material stiff_mat */
+    int stiff_checker;      /* pattern: 1 checkerboard of cells, 0 random per particle */
+    double stiff_factor, stiff_cell;
+    uint64_t stiff_seed;
+    int stiff_mat;
     size_t surf_n;   /* surface particles (after --scale) */
     Shape *surf_mesh; /* "vertices_of": take (a subset of) its vertices; else surface samples */
     int has_variation; /* "variation": clumpy density (and snow pre-compaction) */
@@ -403,31 +411,152 @@ static int parse_surface(json_t *j, const char *file, const char *path, const ch
     return MPM_OK;
 }
 
+/* "initial_F": {"type": "random_diagonal", "min", "max", "seed", "per_particle"}
+ * or {"type": "diagonal", "values": [d0, d1, d2]}, either with
+ * "inverted_fraction". */
 static int parse_initial_F(json_t *j, const char *file, const char *path, uint64_t default_seed,
                            ObjectSpec *o)
 {
-    static const char *const keys[] = {"type", "min", "max", "seed", "per_particle", NULL};
+    static const char *const keys[] = {"type", "min", "max", "seed", "per_particle", "values", "inverted_fraction",
+                                       NULL};
+    static const char *const fixed_keys[] = {"type", "values", "seed", "inverted_fraction", NULL};
     int st = sj_check_object(j, file, path, keys);
     if (st) return st;
     const char *type = NULL;
     if ((st = sj_string(j, "type", 1, file, path, &type, NULL))) return st;
-    if (strcmp(type, "random_diagonal") != 0)
-        return sj_bad(file, path, "type", "expected \"random_diagonal\"", json_object_get(j, "type"));
-    if ((st = sj_positive(j, "min", 1, file, path, &o->F_min, NULL))) return st;
-    if ((st = sj_number(j, "max", 1, file, path, &o->F_max, NULL))) return st;
-    if (!(o->F_max >= o->F_min)) return sj_bad_number(file, path, "max", "expected a number >= min", o->F_max);
+    if (strcmp(type, "diagonal") == 0) {
+        if ((st = sj_check_object(j, file, path, fixed_keys))) return st;
+        if ((st = sj_vec3(j, "values", 1, file, path, o->F_values, NULL))) return st;
+        for (int d = 0; d < 3; ++d)
+            if (!(o->F_values[d] != 0.0) || !isfinite(o->F_values[d]))
+                return sj_bad(file, path, "values", "expected three non-zero finite numbers", json_object_get(j, "values"));
+        o->F_fixed = 1;
+    } else if (strcmp(type, "random_diagonal") == 0) {
+        if (json_object_get(j, "values"))
+            return sj_bad(file, path, "values", "expected no \"values\" for \"random_diagonal\" (min, max)",
+                          json_object_get(j, "values"));
+        if ((st = sj_positive(j, "min", 1, file, path, &o->F_min, NULL))) return st;
+        if ((st = sj_number(j, "max", 1, file, path, &o->F_max, NULL))) return st;
+        if (!(o->F_max >= o->F_min)) return sj_bad_number(file, path, "max", "expected a number >= min", o->F_max);
+        o->F_per_particle = 1;
+        if ((st = sj_bool(j, "per_particle", 0, file, path, &o->F_per_particle, NULL))) return st;
+    } else {
+        return sj_bad(file, path, "type", "expected \"random_diagonal\" or \"diagonal\"", json_object_get(j, "type"));
+    }
     if ((st = parse_seed(j, file, path, default_seed, &o->F_seed))) return st;
-    o->F_per_particle = 1;
-    if ((st = sj_bool(j, "per_particle", 0, file, path, &o->F_per_particle, NULL))) return st;
+    o->F_inverted = 0.0;
+    if ((st = sj_number(j, "inverted_fraction", 0, file, path, &o->F_inverted, NULL))) return st;
+    if (!(o->F_inverted >= 0.0 && o->F_inverted <= 1.0))
+        return sj_bad_number(file, path, "inverted_fraction", "expected a fraction in [0, 1]", o->F_inverted);
     o->has_F = 1;
     return MPM_OK;
+}
+
+/* The object's initial F of particle k (diag, in order): the fixed or random
+ * diagonal, then d0 negated for the inverted share. `rng` and `flip` are
+ * seeded from F_seed by the caller. */
+static void initial_F_diagonal(const ObjectSpec *o, size_t k, Rng *rng, Rng *flip, double diag[3])
+{
+    if (o->F_fixed) {
+        for (int d = 0; d < 3; ++d) diag[d] = o->F_values[d];
+    } else if (o->F_per_particle || k == 0) {
+        for (int d = 0; d < 3; ++d) diag[d] = rng_uniform(rng, o->F_min, o->F_max);
+    }
+    if (o->F_inverted > 0.0 && rng_uniform(flip, 0.0, 1.0) < o->F_inverted) diag[0] = -fabs(diag[0]);
+    else if (!o->F_fixed) diag[0] = fabs(diag[0]);
+}
+
+/* "stiffness_variation": {"pattern": "checkerboard" | "random", "factor": f,
+ * "cell": L (checkerboard), "seed" (random)}. */
+static int parse_stiffness_variation(json_t *j, const char *file, const char *path, double dx, uint64_t default_seed,
+                                     ObjectSpec *o)
+{
+    static const char *const keys[] = {"pattern", "factor", "cell", "seed", NULL};
+    int st = sj_check_object(j, file, path, keys);
+    if (st) return st;
+    const char *pattern = NULL;
+    if ((st = sj_string(j, "pattern", 1, file, path, &pattern, NULL))) return st;
+    if (strcmp(pattern, "checkerboard") == 0) o->stiff_checker = 1;
+    else if (strcmp(pattern, "random") == 0) o->stiff_checker = 0;
+    else return sj_bad(file, path, "pattern", "expected \"checkerboard\" or \"random\"", json_object_get(j, "pattern"));
+    if ((st = sj_positive(j, "factor", 1, file, path, &o->stiff_factor, NULL))) return st;
+    if (!isfinite(o->stiff_factor))
+        return sj_bad_number(file, path, "factor", "expected a positive finite number", o->stiff_factor);
+    o->stiff_cell = dx;
+    if (!o->stiff_checker && json_object_get(j, "cell"))
+        return sj_bad(file, path, "cell", "expected no \"cell\" for the random pattern", json_object_get(j, "cell"));
+    if ((st = sj_positive(j, "cell", 0, file, path, &o->stiff_cell, NULL))) return st;
+    if (!isfinite(o->stiff_cell))
+        return sj_bad_number(file, path, "cell", "expected a positive finite length [m]", o->stiff_cell);
+    if (o->stiff_checker && json_object_get(j, "seed"))
+        return sj_bad(file, path, "seed", "expected no \"seed\" for the checkerboard pattern", json_object_get(j, "seed"));
+    if ((st = parse_seed(j, file, path, default_seed, &o->stiff_seed))) return st;
+    o->has_stiffness_var = 1;
+    return MPM_OK;
+}
+
+/* The stiffer (or softer) twin of each varied object's material: a copy with
+ * E times the factor, named "NAME*FACTOR", added once per (material, factor)
+ * after the scene's materials. */
+static int add_stiffness_materials(Scene *sc, const char *file, ObjectSpec *objs, int nobj)
+{
+    for (int i = 0; i < nobj; ++i) {
+        ObjectSpec *o = &objs[i];
+        if (!o->has_stiffness_var) continue;
+        const Material *base = &sc->materials[o->mat];
+        char name[64];
+        snprintf(name, sizeof name, "%.40s*%g", base->name, o->stiff_factor);
+        o->stiff_mat = -1;
+        for (int k = 0; k < sc->n_materials; ++k)
+            if (strcmp(sc->materials[k].name, name) == 0) o->stiff_mat = k;
+        if (o->stiff_mat >= 0) continue;
+        Material *m = realloc(sc->materials, sizeof(Material) * (size_t)(sc->n_materials + 1));
+        if (!m) return mpm_error(MPM_EINTERNAL, "out of memory");
+        sc->materials = m;
+        Material *t = &sc->materials[sc->n_materials];
+        *t = sc->materials[o->mat];
+        snprintf(t->name, sizeof t->name, "%s", name);
+        t->E *= o->stiff_factor;
+        material_derive(t);
+        if (!isfinite(t->E) || !isfinite(t->mu) || !isfinite(t->lambda) || !isfinite(t->stiffness))
+            return mpm_error(MPM_EINPUT,
+                             "%s: objects.%d.stiffness_variation.factor: E = %g times %g gives non-finite Lame parameters",
+                             file, i, sc->materials[o->mat].E, o->stiff_factor);
+        o->stiff_mat = sc->n_materials++;
+    }
+    return MPM_OK;
+}
+
+/* Assigns the twin material to the checkerboard's odd cells (floor(x / cell)
+ * summed over the axes) or to a random half of the particles. */
+static void apply_stiffness_variations(Scene *sc, const ObjectSpec *objs, int nobj)
+{
+    Particles *P = &sc->particles;
+    for (int i = 0; i < nobj; ++i) {
+        const ObjectSpec *o = &objs[i];
+        if (!o->has_stiffness_var) continue;
+        Rng rng;
+        rng_seed(&rng, o->stiff_seed);
+        for (size_t k = sc->object_offsets[i]; k < sc->object_offsets[i + 1]; ++k) {
+            int odd;
+            if (o->stiff_checker) {
+                long long c = 0;
+                for (int d = 0; d < 3; ++d) c += (long long)floor(P->x[3 * k + d] / o->stiff_cell);
+                odd = (int)(c & 1);
+            } else {
+                odd = rng_uniform(&rng, 0.0, 1.0) < 0.5;
+            }
+            if (odd) P->mat[k] = o->stiff_mat;
+        }
+    }
 }
 
 static int parse_object(json_t *j, const char *file, const char *path, uint64_t index, const Scene *sc,
                         const char *asset_dir, double scale, ObjectSpec *o)
 {
     static const char *const keys[] = {"name",      "material",  "shape",          "ppc", "sampling",
-                                       "velocity",  "initial_F", "surface_particles", "variation", NULL};
+                                       "velocity",  "initial_F", "surface_particles", "variation",
+                                       "stiffness_variation", NULL};
     int st = sj_check_object(j, file, path, keys);
     if (st) return st;
     const char *s = NULL;
@@ -478,6 +607,13 @@ static int parse_object(json_t *j, const char *file, const char *path, uint64_t 
         char vp[512];
         sj_path(vp, sizeof vp, path, "variation");
         if ((st = parse_variation(vj, file, vp, rng_mix(sc->seed, 0xC100ull + index), o))) return st;
+    }
+    json_t *svj = json_object_get(j, "stiffness_variation");
+    if (svj) {
+        char sp2[512];
+        sj_path(sp2, sizeof sp2, path, "stiffness_variation");
+        if ((st = parse_stiffness_variation(svj, file, sp2, sc->dx, rng_mix(sc->seed, 0x5E00ull + index), o)))
+            return st;
     }
     if ((st = shape_parse(sh, file, sp, asset_dir, sc->dx, &o->shape))) return st;
     json_t *surf = json_object_get(j, "surface_particles");
@@ -624,17 +760,16 @@ static int sample_objects(Scene *sc, const char *file, ObjectSpec *objs, int nob
         Particles *P = &sc->particles;
         size_t first = P->n;
         if (!st) st = particles_reserve(P, P->n + pts.n);
-        Rng rng;
+        Rng rng, flip;
         double diag[3] = {1, 1, 1};
         if (o->has_F) {
             rng_seed(&rng, o->F_seed);
-            for (int d = 0; d < 3; ++d) diag[d] = rng_uniform(&rng, o->F_min, o->F_max);
+            rng_seed(&flip, rng_mix(o->F_seed, 0x1F11ull)); /* its own stream: the diagonals stay as before */
         }
         for (size_t k = 0; k < pts.n && !st; ++k) {
             st = particles_push(P, pts.x + 3 * k, o->velocity, mass, vp, o->mat);
             if (st || !o->has_F) continue;
-            if (o->F_per_particle && k > 0)
-                for (int d = 0; d < 3; ++d) diag[d] = rng_uniform(&rng, o->F_min, o->F_max);
+            initial_F_diagonal(o, k, &rng, &flip, diag);
             double *F = P->F + 9 * (first + k);
             F[0] = diag[0], F[4] = diag[1], F[8] = diag[2];
         }
@@ -841,6 +976,8 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
         st = parse_object(json_array_get(objs, i), file, p, (uint64_t)i, sc, asset_dir, scale, &spec[i]);
     }
 
+    if (!st) st = add_stiffness_materials(sc, file, spec, (int)nobj);
+
     /* colliders */
     json_t *cols = json_object_get(root, "colliders");
     if (!st && cols && !json_is_array(cols))
@@ -876,6 +1013,7 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
         if (snow) st = particles_enable_plastic_state(&sc->particles); /* only hardening reads Jp */
     }
     if (!st) apply_variations(sc, spec, (int)nobj);
+    if (!st) apply_stiffness_variations(sc, spec, (int)nobj);
     for (size_t i = 0; i < nobj; ++i) {
         shape_free(spec[i].shape);
         shape_free(spec[i].surf_mesh);

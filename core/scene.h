@@ -81,7 +81,15 @@
  *                                     uniform in [min, max] (0 < min <= max),
  *                                     per particle (default) or one for the
  *                                     whole object; seed defaults to one
- *                                     derived from the scene seed
+ *                                     derived from the scene seed.
+ *                   | {"type": "diagonal", "values": [1, 1, 1e-4]}
+ *                                     F = diag(values) for every particle
+ *                                     (non-zero finite entries, any sign: a
+ *                                     degenerate or inverted start)
+ *                     either with "inverted_fraction": f in [0, 1] (default
+ *                                     0): each particle independently, with
+ *                                     probability f (seeded), starts with d0
+ *                                     negated, det F < 0 (an inverted state)
  *      "variation": {"amplitude": 0.1, "length": 0.02, "seed": 5}
  *                                     optional: a clumpy material. With the
  *                                     smooth value noise nu(x) in [-1, 1] of
@@ -97,6 +105,20 @@
  *                                     exp(xi (1 - J_p)): denser clumps are
  *                                     stiffer. "seed" (integer >= 0) defaults
  *                                     to one derived from the scene seed.
+ *      "stiffness_variation": {"pattern": "checkerboard", "factor": 1e6, "cell": 0.01}
+ *                                     optional: Young's modulus varying
+ *                                     between neighbours. A twin of the
+ *                                     object's material with E times
+ *                                     "factor" (> 0), named "NAME*FACTOR"
+ *                                     and added after the declared
+ *                                     materials, is given to the particles
+ *                                     in the odd cells of a checkerboard of
+ *                                     "cell" [m] cubes (default: the scene's
+ *                                     dx after --scale; odd = the sum of
+ *                                     floor(x / cell) over the axes) or, with
+ *                                     "pattern": "random", to each particle
+ *                                     with probability 1/2 ("seed", default
+ *                                     derived from the scene seed)
  *      "surface_particles": {"count": N} | {"vertices_of": {mesh shape}}
  *                                     optional: extra particles on the
  *                                     surface, standing in for the

@@ -194,7 +194,8 @@ int step_begin(Simulation *sim)
 {
     const Scene *sc = sim->scene;
     int st;
-    sim->dt = sim_next_dt(sim);
+    sim->dt = sim->dt_next > 0.0 ? sim->dt_next : sim_next_dt(sim);
+    sim->dt_next = 0.0;
     if ((st = grid_build(&sim->grid, &sim->st, &sim->p, sc->dx))) return st;
     transfer_p2g(&sim->grid, &sim->st, &sim->p);
     estimate_volumes(sim);

@@ -26,6 +26,8 @@ typedef struct {
     double t_in_frame;    /* time since the start of the current frame */
     int frame;            /* frames completed */
     double dt;            /* current step */
+    double dt_next;       /* > 0: the next step_begin takes this dt instead of sim_next_dt's, and
+                             clears it (a run replaying a reference run's dt sequence, --dt-from) */
     double *vnew;
     int cap_nodes;
     /* Gast et al. 2015 section 6 options (scene fields, off by default) */

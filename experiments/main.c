@@ -22,12 +22,14 @@ static void usage(FILE *f)
             "               [--scale S] [--threads T] [--out DIR] [--set key=value ...] [--solver-opt key=value ...]\n"
             "               [--history] [--particles DIR] [--asset-dir DIR] [--armijo] [--quiet]\n"
             "               [--max-outer N] [--max-linear N] [--max-step-seconds S] [--max-run-seconds S]\n"
-            "               [--on-failure stop|continue]\n"
+            "               [--on-failure stop|continue] [--error-ref SOLVER[:eps]|auto[:eps]] [--trajectory]\n"
+            "               [--dt-from RUN_DIR] [--trajectory-ref RUN_DIR]\n"
             "  mpmbench bench spmv|assemble|p2g|all --scene NAME [--scale S] [--threads T] [--set key=value ...]\n"
             "  mpmbench render --scene NAME|FILE [--frame N] [--out FILE.png] [--solver NAME] [--scale S] [--set key=value ...]\n"
             "               [--view front|side|top|iso] [--color material|speed] [--width W] [--height H] [--asset-dir DIR] [--threads T]\n"
             "  mpmbench matrix run FILE [--out DIR] [--only GLOB ...] [--dry-run] [--jobs N] [--threads T] [--asset-dir DIR]\n"
-            "               (under mpirun -np K: the cells spread over K ranks; --check: reserved)\n"
+            "               [--check]  (under mpirun -np K: the cells spread over K ranks; --check: pass/fail\n"
+            "               per cell into DIR/check.csv, exit 1 when a cell failed)\n"
             "  mpmbench matrix report DIR     (DIR/report.md and PNGs from a matrix run)\n");
 }
 
@@ -119,6 +121,10 @@ static int parse_args(int argc, char **argv, int first, Args *a)
             if (c->threads < 1) return mpm_error(MPM_EINPUT, "--threads %d: expected >= 1", c->threads);
         } else if (!strcmp(f, "--out")) { NEED_VAL(); c->out_dir = val; }
         else if (!strcmp(f, "--particles")) { NEED_VAL(); c->particles_dir = val; }
+        else if (!strcmp(f, "--error-ref")) { NEED_VAL(); c->error_ref = val; }
+        else if (!strcmp(f, "--dt-from")) { NEED_VAL(); c->dt_from = val; }
+        else if (!strcmp(f, "--trajectory-ref")) { NEED_VAL(); c->trajectory_ref = val; }
+        else if (!strcmp(f, "--trajectory")) c->trajectory = 1;
         else if (!strcmp(f, "--asset-dir")) { NEED_VAL(); c->asset_dir = val; }
         else if (!strcmp(f, "--set")) {
             NEED_VAL();

@@ -2,6 +2,7 @@
  * (matrix_cells.h). */
 #include "experiments/matrix_cells.h"
 
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -113,19 +114,49 @@ static void text_kv(Text *t, const MatrixKv *kv, int n)
 static int cell_identify(MatrixCell *c)
 {
     Text t = {NULL, 0, 0, 0};
+    /* the settings added with the accuracy axis and the limits enter only when
+     * set, so the ids of cells without them stay as they were */
     text_add(&t, "{");
     text_key(&t, "armijo", 1);
     text_add(&t, c->armijo ? "true" : "false");
     text_key(&t, "eps", 0);
     text_number(&t, c->eps);
+    if (c->error_ref[0]) {
+        text_key(&t, "error_ref", 0);
+        text_string(&t, c->error_ref);
+    }
     text_key(&t, "first_timed_frame", 0);
     text_int(&t, c->first_timed_frame);
     text_key(&t, "frames", 0);
     text_int(&t, c->frames);
     text_key(&t, "history", 0);
     text_add(&t, c->history ? "true" : "false");
+    if (c->max_linear) {
+        text_key(&t, "max_linear", 0);
+        text_int(&t, c->max_linear);
+    }
+    if (c->max_outer) {
+        text_key(&t, "max_outer", 0);
+        text_int(&t, c->max_outer);
+    }
+    if (c->max_run_s > 0) {
+        text_key(&t, "max_run_seconds", 0);
+        text_number(&t, c->max_run_s);
+    }
+    if (c->max_step_s > 0) {
+        text_key(&t, "max_step_seconds", 0);
+        text_number(&t, c->max_step_s);
+    }
+    if (c->on_failure[0]) {
+        text_key(&t, "on_failure", 0);
+        text_string(&t, c->on_failure);
+    }
     text_key(&t, "particles", 0);
     text_add(&t, c->particles ? "true" : "false");
+    if (c->ref_id[0]) {
+        text_key(&t, "reference", 0);
+        text_string(&t, c->ref_id);
+    }
     text_key(&t, "scale", 0);
     text_number(&t, c->scale);
     text_key(&t, "scene", 0);
@@ -138,6 +169,10 @@ static int cell_identify(MatrixCell *c)
     text_kv(&t, c->solver_opts, c->n_solver_opts);
     text_key(&t, "threads", 0);
     text_int(&t, c->threads);
+    if (c->trajectory) {
+        text_key(&t, "trajectory", 0);
+        text_add(&t, "true");
+    }
     text_add(&t, "}");
     if (t.bad) {
         free(t.s);
@@ -159,6 +194,7 @@ static int rule_value_matches(const Matrix *m, const MatrixCell *c, const char *
     else snprintf(text, sizeof text, "%s", json_string_value(v));
     if (!strcmp(key, "scene")) return !strcmp(text, c->scene);
     if (!strcmp(key, "solver")) return !strcmp(text, c->solver);
+    if (!strcmp(key, "error_ref")) return !strcmp(text, c->error_ref);
     int a = matrix_named_index(m, key);
     return a >= 0 && !strcmp(text, m->named[a].values[c->value[a]].label);
 }
@@ -210,8 +246,28 @@ static int copy_kv(const MatrixKvList *l, MatrixKv **out, int *n)
     return MPM_OK;
 }
 
-/* The cell at one point of the product: idx[0..4] index scene, solver, eps,
- * scale, threads (-1 = the defaults' value), idx[5+a] the named axis a. */
+/* The run limits and error reference: defaults < per-scene settings. */
+static void run_settings(const MatrixSettings *d, const MatrixSettings *ps, MatrixCell *c)
+{
+    const MatrixSettings *src[2] = {d, ps};
+    for (int k = 0; k < 2; ++k) {
+        const MatrixSettings *s = src[k];
+        if (!s) continue;
+        if (s->has_error_ref) snprintf(c->error_ref, sizeof c->error_ref, "%s", s->error_ref);
+        if (s->has_trajectory) c->trajectory = s->trajectory;
+        if (s->has_max_outer) c->max_outer = s->max_outer;
+        if (s->has_max_linear) c->max_linear = s->max_linear;
+        if (s->has_max_step_s) c->max_step_s = s->max_step_s;
+        if (s->has_max_run_s) c->max_run_s = s->max_run_s;
+        if (s->has_on_failure) snprintf(c->on_failure, sizeof c->on_failure, "%s", s->on_failure);
+    }
+}
+
+#define FIXED_AXES 6 /* scene, solver, eps, scale, threads, error_ref */
+
+/* The cell at one point of the product: idx[0..5] index scene, solver, eps,
+ * scale, threads, error_ref (-1 = the defaults' value), idx[FIXED_AXES+a]
+ * the named axis a. Not identified yet (cell_identify). */
 static int build_cell(const Matrix *m, const int *idx, MatrixCell *c)
 {
     const MatrixSettings *d = &m->defaults;
@@ -236,11 +292,14 @@ static int build_cell(const Matrix *m, const int *idx, MatrixCell *c)
     c->particles = d->particles;
     snprintf(c->asset_dir, sizeof c->asset_dir, "%s", d->has_asset_dir ? d->asset_dir : "");
     c->timeout_s = m->cell_timeout_s;
+    c->ref = -1;
+    run_settings(d, ps, c);
+    if (idx[5] >= 0) snprintf(c->error_ref, sizeof c->error_ref, "%s", m->error_refs[idx[5]]);
     MatrixKvList set = d->set, opts = d->solver_opts;
     int st = ps ? kv_merge(m, c->scene, &set, &ps->set) : MPM_OK;
     for (int a = 0; a < m->n_named && !st; ++a) {
-        c->value[a] = idx[5 + a];
-        const MatrixNamedValue *v = &m->named[a].values[idx[5 + a]];
+        c->value[a] = idx[FIXED_AXES + a];
+        const MatrixNamedValue *v = &m->named[a].values[idx[FIXED_AXES + a]];
         st = kv_merge(m, c->scene, m->named[a].kind == MATRIX_SET ? &set : &opts, &v->kv);
     }
     if (st) return st;
@@ -249,7 +308,39 @@ static int build_cell(const Matrix *m, const int *idx, MatrixCell *c)
                          c->first_timed_frame, c->frames);
     st = copy_kv(&set, &c->set, &c->n_set);
     if (!st) st = copy_kv(&opts, &c->solver_opts, &c->n_solver_opts);
-    if (!st) st = cell_identify(c);
+    return st;
+}
+
+/* The scene's reference run spec, or NULL. */
+static const MatrixReference *scene_reference(const Matrix *m, const char *scene)
+{
+    const MatrixSettings *ps = scene_settings(m, scene);
+    if (ps && ps->has_reference) return ps->reference.has ? &ps->reference : NULL;
+    return m->reference.has ? &m->reference : NULL;
+}
+
+/* The reference cell of c: c's settings with the reference's solver, eps and
+ * solver options, no error reference, writing its trajectory. */
+static int build_reference(const MatrixReference *r, const MatrixCell *c, MatrixCell *ref)
+{
+    *ref = *c;
+    ref->set = ref->solver_opts = NULL;
+    ref->canonical = NULL;
+    ref->n_set = ref->n_solver_opts = 0;
+    snprintf(ref->solver, sizeof ref->solver, "%s", r->solver);
+    snprintf(ref->solver_origin, sizeof ref->solver_origin, "%s.solver", r->origin);
+    ref->eps = r->eps;
+    ref->error_ref[0] = '\0';
+    ref->trajectory = 1;
+    ref->history = ref->particles = 0;
+    ref->is_reference = 1;
+    ref->ref = -1;
+    ref->ref_id[0] = '\0';
+    MatrixKvList set = {.n = 0};
+    for (int i = 0; i < c->n_set; ++i) set.kv[set.n++] = c->set[i];
+    int st = copy_kv(&set, &ref->set, &ref->n_set);
+    if (!st) st = copy_kv(&r->solver_opts, &ref->solver_opts, &ref->n_solver_opts);
+    if (!st) st = cell_identify(ref);
     return st;
 }
 
@@ -261,42 +352,85 @@ static void cell_release(MatrixCell *c)
     memset(c, 0, sizeof *c);
 }
 
+/* Index of the cell with c's id among cells[0..n), -1 when none;
+ * MPM_EINTERNAL (as -2) when the id names other settings. */
+static int find_same(const MatrixCell *cells, int n, const MatrixCell *c)
+{
+    for (int j = 0; j < n; ++j) {
+        if (strcmp(cells[j].id, c->id)) continue;
+        if (strcmp(cells[j].canonical, c->canonical)) {
+            mpm_error(MPM_EINTERNAL, "cell id %s names two different settings: %s and %s", c->id, cells[j].canonical,
+                      c->canonical);
+            return -2;
+        }
+        return j;
+    }
+    return -1;
+}
+
+/* Puts the reference cells first and points every dependent cell at its own. */
+static int prepend_references(MatrixCells *out, MatrixCell *refs, int n_refs)
+{
+    if (!n_refs) return MPM_OK;
+    MatrixCell *all = calloc((size_t)(out->n + n_refs), sizeof *all);
+    if (!all) return mpm_error(MPM_EINTERNAL, "out of memory (%d cells)", out->n + n_refs);
+    memcpy(all, refs, sizeof *all * (size_t)n_refs);
+    memcpy(all + n_refs, out->cells, sizeof *all * (size_t)out->n);
+    free(out->cells);
+    out->cells = all;
+    out->n += n_refs;
+    for (int i = n_refs; i < out->n; ++i)
+        for (int j = 0; j < n_refs && out->cells[i].ref_id[0]; ++j)
+            if (!strcmp(out->cells[j].id, out->cells[i].ref_id)) out->cells[i].ref = j;
+    return MPM_OK;
+}
+
 int matrix_expand(const Matrix *m, MatrixCells *out)
 {
     memset(out, 0, sizeof *out);
-    int n_axes = 5 + m->n_named;
-    int size[5 + MATRIX_MAX_AXES];
+    int n_axes = FIXED_AXES + m->n_named;
+    int size[FIXED_AXES + MATRIX_MAX_AXES];
     size[0] = m->n_scenes;
     size[1] = m->n_solvers;
     size[2] = m->n_eps;
     size[3] = m->n_scales;
     size[4] = m->n_threads;
-    for (int a = 0; a < m->n_named; ++a) size[5 + a] = m->named[a].n;
+    size[5] = m->n_error_refs;
+    for (int a = 0; a < m->n_named; ++a) size[FIXED_AXES + a] = m->named[a].n;
     size_t total = 1;
     for (int a = 0; a < n_axes; ++a) {
         total *= (size_t)(size[a] > 0 ? size[a] : 1);
         if (total > 1000000) return mpm_error(MPM_EINPUT, "%s: more than a million cells", m->base);
     }
     out->cells = calloc(total, sizeof *out->cells);
-    if (!out->cells) return mpm_error(MPM_EINTERNAL, "out of memory (%zu cells)", total);
-    int idx[5 + MATRIX_MAX_AXES];
+    MatrixCell *refs = calloc(total, sizeof *refs);
+    int n_refs = 0;
+    if (!out->cells || !refs) {
+        free(refs);
+        return mpm_error(MPM_EINTERNAL, "out of memory (%zu cells)", total);
+    }
+    int idx[FIXED_AXES + MATRIX_MAX_AXES];
     for (int a = 0; a < n_axes; ++a) idx[a] = size[a] > 0 ? 0 : -1;
-    for (size_t k = 0; k < total; ++k) {
+    int st = MPM_OK;
+    for (size_t k = 0; k < total && !st; ++k) {
         MatrixCell *c = &out->cells[out->n];
-        int st = build_cell(m, idx, c);
-        if (st) {
-            cell_release(c);
-            return st;
+        st = build_cell(m, idx, c);
+        int keep = !st && rules_keep(m, c);
+        const MatrixReference *r = keep ? scene_reference(m, c->scene) : NULL;
+        if (r) { /* the reference first: its id is part of the cell's settings */
+            MatrixCell *rc = &refs[n_refs];
+            st = build_reference(r, c, rc);
+            int j = st ? -1 : find_same(refs, n_refs, rc);
+            if (j == -2) st = MPM_EINTERNAL;
+            if (!st) snprintf(c->ref_id, sizeof c->ref_id, "%s", rc->id);
+            if (!st && j < 0) n_refs++;
+            else cell_release(rc);
         }
-        int keep = rules_keep(m, c);
-        for (int j = 0; j < out->n && keep; ++j) {
-            if (strcmp(out->cells[j].id, c->id)) continue;
-            if (strcmp(out->cells[j].canonical, c->canonical))
-                return mpm_error(MPM_EINTERNAL, "cell id %s names two different settings: %s and %s", c->id,
-                                 out->cells[j].canonical, c->canonical);
-            keep = 0; /* identical effective settings run once */
-        }
-        if (keep) out->n++;
+        if (!st && keep) st = cell_identify(c);
+        int j = !st && keep ? find_same(out->cells, out->n, c) : -1;
+        if (j == -2) st = MPM_EINTERNAL;
+        if (j >= 0) keep = 0; /* identical effective settings run once */
+        if (!st && keep) out->n++;
         else cell_release(c);
         /* odometer: the last axis varies fastest */
         for (int a = n_axes - 1; a >= 0; --a) {
@@ -305,7 +439,11 @@ int matrix_expand(const Matrix *m, MatrixCells *out)
             idx[a] = 0;
         }
     }
-    return MPM_OK;
+    if (!st) st = prepend_references(out, refs, n_refs);
+    else
+        for (int i = 0; i < n_refs; ++i) cell_release(&refs[i]);
+    free(refs);
+    return st;
 }
 
 void matrix_cells_free(MatrixCells *c)
@@ -318,11 +456,16 @@ void matrix_cells_free(MatrixCells *c)
 void matrix_cells_keep(MatrixCells *c, const int *keep)
 {
     int k = 0;
+    int *moved = malloc(sizeof(int) * (size_t)(c->n + 1));
     for (int i = 0; i < c->n; ++i) {
+        if (moved) moved[i] = keep[i] ? k : -1;
         if (keep[i]) c->cells[k++] = c->cells[i];
         else cell_release(&c->cells[i]);
     }
     c->n = k;
+    for (int i = 0; i < k; ++i)
+        if (c->cells[i].ref >= 0) c->cells[i].ref = moved ? moved[c->cells[i].ref] : -1;
+    free(moved);
 }
 
 void matrix_cell_name(const MatrixCell *c, char *out, size_t n) { snprintf(out, n, "%s/%s", c->scene, c->solver); }
@@ -336,8 +479,11 @@ void matrix_cell_describe(const Matrix *m, const MatrixCell *c, char *out, size_
     if (c->threads && len < n) len += (size_t)snprintf(out + len, n - len, " threads=%d", c->threads);
     if (c->frames && len < n) len += (size_t)snprintf(out + len, n - len, " frames=%d", c->frames);
     if (c->first_timed_frame && len < n) len += (size_t)snprintf(out + len, n - len, " timed-from=%d", c->first_timed_frame);
+    if (c->error_ref[0] && len < n) len += (size_t)snprintf(out + len, n - len, " error_ref=%s", c->error_ref);
     for (int a = 0; a < m->n_named && len < n; ++a)
         len += (size_t)snprintf(out + len, n - len, " %s=%s", m->named[a].name, m->named[a].values[c->value[a]].label);
+    if (c->is_reference && len < n) len += (size_t)snprintf(out + len, n - len, " (reference run)");
+    else if (c->ref_id[0] && len < n) len += (size_t)snprintf(out + len, n - len, " reference=%s", c->ref_id);
 }
 
 /* Appends one NUL-terminated argument. */
@@ -395,6 +541,42 @@ int matrix_cell_argv(const Matrix *m, const MatrixCell *c, const char *out_dir, 
     if (c->asset_dir[0]) {
         st |= push_arg(buf, cap, &used, argc, "%s%s", "--asset-dir", "");
         st |= push_arg(buf, cap, &used, argc, "%s%s", c->asset_dir, "");
+    }
+    if (c->error_ref[0]) {
+        st |= push_arg(buf, cap, &used, argc, "%s%s", "--error-ref", "");
+        st |= push_arg(buf, cap, &used, argc, "%s%s", c->error_ref, "");
+    }
+    if (c->trajectory) st |= push_arg(buf, cap, &used, argc, "%s%s", "--trajectory", "");
+    const int ints[2] = {c->max_outer, c->max_linear};
+    const char *int_flags[2] = {"--max-outer", "--max-linear"};
+    for (int k = 0; k < 2; ++k) {
+        if (!ints[k]) continue;
+        snprintf(num, sizeof num, "%d", ints[k]);
+        st |= push_arg(buf, cap, &used, argc, "%s%s", int_flags[k], "");
+        st |= push_arg(buf, cap, &used, argc, "%s%s", num, "");
+    }
+    const double secs[2] = {c->max_step_s, c->max_run_s};
+    const char *sec_flags[2] = {"--max-step-seconds", "--max-run-seconds"};
+    for (int k = 0; k < 2; ++k) {
+        if (!(secs[k] > 0)) continue;
+        if (secs[k] == floor(secs[k])) snprintf(num, sizeof num, "%.0f", secs[k]); /* 30, not 3e+01 */
+        else matrix_format_number(secs[k], num, sizeof num);
+        st |= push_arg(buf, cap, &used, argc, "%s%s", sec_flags[k], "");
+        st |= push_arg(buf, cap, &used, argc, "%s%s", num, "");
+    }
+    if (c->on_failure[0]) {
+        st |= push_arg(buf, cap, &used, argc, "%s%s", "--on-failure", "");
+        st |= push_arg(buf, cap, &used, argc, "%s%s", c->on_failure, "");
+    }
+    if (c->ref_id[0]) { /* the reference's directory: out_dir's sibling */
+        const char *slash = strrchr(out_dir, '/');
+        int w = slash ? snprintf(ply, sizeof ply, "%.*s/%s", (int)(slash - out_dir), out_dir, c->ref_id)
+                      : snprintf(ply, sizeof ply, "%s", c->ref_id);
+        if (w < 0 || (size_t)w >= sizeof ply) st |= mpm_error(MPM_EINPUT, "cell command line too long");
+        st |= push_arg(buf, cap, &used, argc, "%s%s", "--dt-from", "");
+        st |= push_arg(buf, cap, &used, argc, "%s%s", ply, "");
+        st |= push_arg(buf, cap, &used, argc, "%s%s", "--trajectory-ref", "");
+        st |= push_arg(buf, cap, &used, argc, "%s%s", ply, "");
     }
     st |= push_arg(buf, cap, &used, argc, "%s%s", "--quiet", "");
     st |= push_arg(buf, cap, &used, argc, "%s%s", "--out", "");

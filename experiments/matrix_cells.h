@@ -31,6 +31,14 @@ typedef struct {
     char scene_origin[256], solver_origin[256];
     char *canonical;
     double timeout_s;            /* 0 = none */
+    char error_ref[160];         /* "" = none */
+    int trajectory;
+    int max_outer, max_linear;   /* 0 = run's default */
+    double max_step_s, max_run_s;/* 0 = none */
+    char on_failure[16];         /* "" = run's default (stop) */
+    int is_reference;            /* a reference run other cells depend on */
+    int ref;                     /* index of this cell's reference cell, -1 = none */
+    char ref_id[16];             /* its id ("" = none) */
 } MatrixCell;
 
 typedef struct {
@@ -39,12 +47,16 @@ typedef struct {
 } MatrixCells;
 
 /* Every cell of the matrix, in product order (scene slowest, then solver,
- * eps, scale, threads, the named axes in file order), rules applied,
- * duplicates removed. MPM_EINPUT when a cell's settings are inconsistent
- * (a first timed frame not before its frames). */
+ * eps, scale, threads, error_ref, the named axes in file order), rules
+ * applied, duplicates removed; the reference cells (matrix_file.h
+ * "reference") first, in the order they are first needed. A dependent
+ * cell's canonical settings include its reference's id. MPM_EINPUT when a
+ * cell's settings are inconsistent (a first timed frame not before its
+ * frames). */
 int matrix_expand(const Matrix *m, MatrixCells *out);
 void matrix_cells_free(MatrixCells *c);
-/* Keeps the cells i with keep[i] != 0, in order. */
+/* Keeps the cells i with keep[i] != 0, in order (the reference indices
+ * renumbered; a kept cell's reference must be kept). */
 void matrix_cells_keep(MatrixCells *c, const int *keep);
 
 /* "scene/solver" */
@@ -53,7 +65,9 @@ void matrix_cell_name(const MatrixCell *c, char *out, size_t n);
 void matrix_cell_describe(const Matrix *m, const MatrixCell *c, char *out, size_t n);
 
 /* The `mpmbench run` arguments (without the program) that compute the cell
- * into out_dir, NUL-separated in buf; *argc set. MPM_EINPUT if too long. */
+ * into out_dir, NUL-separated in buf; *argc set. MPM_EINPUT if too long. A
+ * dependent cell gets --dt-from and --trajectory-ref with its reference's
+ * directory, the sibling of out_dir named by the reference's id. */
 int matrix_cell_argv(const Matrix *m, const MatrixCell *c, const char *out_dir, char *buf, size_t cap, int *argc);
 
 #endif

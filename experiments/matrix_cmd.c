@@ -28,7 +28,7 @@ static int cmd_run(int argc, char **argv)
 {
     if (argc < 4 || argv[3][0] == '-') return mpm_error(MPM_EINPUT, "matrix run: expected a matrix file (see: mpmbench --help)");
     static const char *only[MAX_ONLY];
-    MatrixRunOptions o = {NULL, only, 0, 0, 1, NULL, 0};
+    MatrixRunOptions o = {NULL, only, 0, 0, 1, NULL, 0, 0};
     for (int i = 4; i < argc; ++i) {
         const char *f = argv[i];
         int has_val = i + 1 < argc;
@@ -36,7 +36,10 @@ static int cmd_run(int argc, char **argv)
             o.dry_run = 1;
             continue;
         }
-        if (!strcmp(f, "--check")) return mpm_error(MPM_EINPUT, "matrix run --check: reserved, not implemented yet");
+        if (!strcmp(f, "--check")) {
+            o.check = 1;
+            continue;
+        }
         if (strcmp(f, "--out") && strcmp(f, "--only") && strcmp(f, "--jobs") && strcmp(f, "--asset-dir") &&
             strcmp(f, "--threads"))
             return mpm_error(MPM_EINPUT, "matrix run: unknown option '%s' (see: mpmbench --help)", f);

@@ -4,12 +4,13 @@
  * matplotlib it needs; MPM_PYTHON and MPM_SCRIPT_DIR override both).
  *
  *   mpmbench matrix run FILE [--out DIR] [--only GLOB ...] [--dry-run]
- *                       [--jobs N] [--asset-dir DIR]
+ *                       [--jobs N] [--asset-dir DIR] [--check]
  *   mpmbench matrix report DIR
  *
  * --only GLOB (repeatable) keeps the cells whose id or "scene/solver"
  * matches; --jobs N runs N cells at a time per process (default 1: a cell
- * uses its own threads); --check is reserved for a later issue. */
+ * uses its own threads); --check decides pass or fail per cell
+ * (experiments/matrix_check.h) and exits 1 when any failed. */
 #ifndef MPM_MATRIX_CMD_H
 #define MPM_MATRIX_CMD_H
 

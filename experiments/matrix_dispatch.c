@@ -150,26 +150,84 @@ static int task_bytes(const MatrixTask *t) { return (int)(offsetof(MatrixTask, a
 
 /* ---------------------------------------------------------------- rank 0 */
 
+enum { TASK_PENDING = 0, TASK_RUNNING, TASK_OK, TASK_NOT_OK, TASK_SKIPPED };
+
+/* Rank 0's view of the task list: which are pending, running, done. */
+typedef struct {
+    const MatrixTask *tasks;
+    int n;
+    unsigned char *state;
+    int finished;   /* done or skipped */
+    int pending;    /* not handed out, not skipped */
+    const MatrixDispatchHooks *h;
+} Board;
+
+/* The first pending task whose dependency ended ok (-1: none ready); tasks
+ * whose dependency did not are skipped on the way. */
+static int board_pick(Board *b)
+{
+    for (int i = 0; i < b->n; ++i) {
+        if (b->state[i] != TASK_PENDING) continue;
+        int a = b->tasks[i].after;
+        int dep = a >= 0 && a < b->n ? b->state[a] : TASK_OK;
+        if (dep == TASK_OK) return i;
+        if (dep == TASK_NOT_OK || dep == TASK_SKIPPED) {
+            b->state[i] = TASK_SKIPPED;
+            b->finished++;
+            b->pending--;
+            if (b->h->skipped) b->h->skipped(b->h->ctx, &b->tasks[i], a >= 0 ? &b->tasks[a] : NULL);
+            i = -1; /* a skip may unblock nothing but skip more: scan again */
+        }
+    }
+    return -1;
+}
+
+static void board_hand_out(Board *b, int i)
+{
+    b->state[i] = TASK_RUNNING;
+    b->pending--;
+}
+
+/* A result of the task with caller's index `index`. */
+static void board_done(Board *b, const MatrixResult *r)
+{
+    for (int i = 0; i < b->n; ++i)
+        if (b->tasks[i].index == r->index && b->state[i] == TASK_RUNNING) {
+            b->state[i] = r->outcome.status == CELL_OK ? TASK_OK : TASK_NOT_OK;
+            b->finished++;
+            return;
+        }
+}
+
 static int serve(const MatrixTask *tasks, int n, int jobs, int use_mpi, const MatrixDispatchHooks *h)
 {
     int ranks = 1;
     if (use_mpi) MPI_Comm_size(MPI_COMM_WORLD, &ranks);
     Slot *slots = calloc((size_t)jobs, sizeof *slots);
-    if (!slots) return mpm_error(MPM_EINTERNAL, "out of memory");
+    Board b = {tasks, n, calloc((size_t)n + 1, 1), 0, n, h};
+    int *waiting = calloc((size_t)ranks, sizeof *waiting); /* ranks asking while no task was ready */
+    if (!slots || !b.state || !waiting) {
+        free(slots);
+        free(b.state);
+        free(waiting);
+        return mpm_error(MPM_EINTERNAL, "out of memory");
+    }
     Outbox out = {.n = 0};
-    int next = 0, results = 0, stopped = 0, remote_running = 0, st = MPM_OK;
-    while (!st && (results < n || stopped < ranks - 1)) {
+    int n_waiting = 0, stopped = 0, remote_running = 0, st = MPM_OK;
+    while (!st && (b.finished < n || stopped < ranks - 1)) {
         int busy_round = 0;
         MatrixResult r;
         for (int i = 0; i < jobs && !st; ++i)
             if (slot_poll(&slots[i], 0, &r)) {
-                results++;
+                board_done(&b, &r);
                 busy_round = 1;
                 st = h->done(h->ctx, &r);
             }
         Slot *s;
-        while (!st && next < n && (s = free_slot(slots, jobs))) {
-            st = slot_start(s, &tasks[next++]);
+        int next;
+        while (!st && (s = free_slot(slots, jobs)) && (next = board_pick(&b)) >= 0) {
+            board_hand_out(&b, next);
+            st = slot_start(s, &tasks[next]);
             busy_round = 1;
         }
         while (!st && use_mpi) {
@@ -180,22 +238,32 @@ static int serve(const MatrixTask *tasks, int n, int jobs, int use_mpi, const Ma
             busy_round = 1;
             if (ms.MPI_TAG == TAG_REQUEST) {
                 MPI_Recv(NULL, 0, MPI_BYTE, ms.MPI_SOURCE, TAG_REQUEST, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-                if (next < n) {
-                    st = outbox_send(&out, &tasks[next], task_bytes(&tasks[next]), ms.MPI_SOURCE, TAG_TASK);
-                    next++;
-                    remote_running++;
-                } else {
-                    st = outbox_send(&out, NULL, 0, ms.MPI_SOURCE, TAG_STOP);
-                    stopped++;
-                }
+                waiting[n_waiting++] = ms.MPI_SOURCE; /* answered below */
             } else if (ms.MPI_TAG == TAG_RESULT) {
                 MPI_Recv(&r, (int)sizeof r, MPI_BYTE, ms.MPI_SOURCE, TAG_RESULT, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-                results++;
                 remote_running--;
+                board_done(&b, &r);
                 st = h->done(h->ctx, &r);
             } else {
                 st = mpm_error(MPM_EINTERNAL, "unexpected MPI message (tag %d) from rank %d", ms.MPI_TAG, ms.MPI_SOURCE);
             }
+        }
+        /* the waiting ranks: a ready task each, or stop once nothing is left to hand out */
+        while (!st && n_waiting > 0) {
+            next = board_pick(&b);
+            int dest = waiting[0];
+            if (next >= 0) {
+                board_hand_out(&b, next);
+                st = outbox_send(&out, &tasks[next], task_bytes(&tasks[next]), dest, TAG_TASK);
+                remote_running++;
+            } else if (b.pending == 0) {
+                st = outbox_send(&out, NULL, 0, dest, TAG_STOP);
+                stopped++;
+            } else {
+                break; /* every remaining task waits for a running one */
+            }
+            memmove(waiting, waiting + 1, sizeof *waiting * (size_t)--n_waiting);
+            busy_round = 1;
         }
         if (use_mpi) outbox_progress(&out);
         if (h->tick) h->tick(h->ctx, count_busy(slots, jobs) + remote_running);
@@ -203,6 +271,8 @@ static int serve(const MatrixTask *tasks, int n, int jobs, int use_mpi, const Ma
     }
     if (use_mpi && !st) outbox_flush(&out);
     free(slots);
+    free(b.state);
+    free(waiting);
     return st;
 }
 

@@ -7,6 +7,12 @@
  * a short sleep between rounds, so waiting costs no core and rank 0 keeps
  * serving MPI while its own child runs.
  *
+ * A task may wait for another (`after`: a dependent cell for its reference
+ * run): it is handed out, to this process or any rank, only after that one
+ * finished with status ok, and is skipped (the `skipped` hook, no result)
+ * when that one did not end ok or was itself skipped. A rank asking for work
+ * while every remaining task waits is answered when one becomes ready.
+ *
  * The cell directories must be on a file system every rank sees (each rank
  * measures the cells it ran and sends the numbers). */
 #ifndef MPM_MATRIX_DISPATCH_H
@@ -20,6 +26,7 @@ typedef struct {
     int index;                 /* the caller's cell index */
     int first_timed_frame;
     double timeout_s;          /* 0: none */
+    int after;                 /* position in the task list of the task this one waits for; -1: none */
     char dir[1024];            /* the cell directory (wiped and recreated) */
     int argc;
     int args_len;
@@ -38,6 +45,8 @@ typedef struct {
     int (*done)(void *ctx, const MatrixResult *r);
     /* rank 0: called between polling rounds (terminal progress), running = cells in flight */
     void (*tick)(void *ctx, int running);
+    /* rank 0: task t will not run because `dep` did not end ok (may be NULL) */
+    void (*skipped)(void *ctx, const MatrixTask *t, const MatrixTask *dep);
     void *ctx;
 } MatrixDispatchHooks;
 

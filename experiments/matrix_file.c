@@ -10,11 +10,13 @@
 
 #include "core/error.h"
 #include "core/scene.h"
+#include "experiments/error_ref.h"
 #include "experiments/registry.h"
 
 /* Column names of cells.csv a named axis may not take. */
-static const char *const g_reserved[] = {"id", "scene", "solver", "eps", "scale", "threads", "frames_asked",
-                                         "first_timed_frame", "set", "solver_opts", "status", "exit"};
+static const char *const g_reserved[] = {"id",          "scene",  "solver", "eps",      "scale",
+                                         "threads",     "frames_asked", "first_timed_frame", "set", "solver_opts",
+                                         "status",      "exit",   "error_ref", "role",   "reference"};
 
 void matrix_format_number(double v, char *out, size_t n)
 {
@@ -200,6 +202,46 @@ static int get_kv(const Matrix *m, json_t *obj, const char *path, MatrixNamedKin
     return MPM_OK;
 }
 
+static int get_error_ref(const Matrix *m, json_t *v, const char *path, char *out, size_t n)
+{
+    int st = get_string(m, v, path, out, n);
+    if (st) return st;
+    if (error_ref_check(out) != MPM_OK) {
+        char msg[1024];
+        snprintf(msg, sizeof msg, "%s", mpm_last_error());
+        mpm_clear_error();
+        return mpm_error(MPM_EINPUT, "%s: %s: %s", m->base, path, msg);
+    }
+    return MPM_OK;
+}
+
+/* "reference": {"solver", "eps", "solver_opts"} (false per scene: none). */
+static int get_reference(const Matrix *m, json_t *v, const char *path, int allow_false, MatrixReference *r)
+{
+    static const char *const keys[] = {"solver", "eps", "solver_opts", NULL};
+    memset(r, 0, sizeof *r);
+    snprintf(r->origin, sizeof r->origin, "%s", path);
+    if (allow_false && json_is_false(v)) return MPM_OK;
+    if (!json_is_object(v))
+        return bad_value(m, path, v, allow_false ? "an object {\"solver\": ...} or false" : "an object {\"solver\": ...}");
+    int st = check_keys(m, v, path, keys);
+    if (st) return st;
+    char p[300];
+    json_t *s = json_object_get(v, "solver");
+    join_path(p, sizeof p, path, "solver");
+    if (!s) return mpm_error(MPM_EINPUT, "%s: %s: missing (required)", m->base, p);
+    if ((st = get_solver(m, s, p, r->solver, sizeof r->solver))) return st;
+    r->eps = 1e-10;
+    json_t *e = json_object_get(v, "eps");
+    join_path(p, sizeof p, path, "eps");
+    if (e && (st = get_positive(m, e, p, &r->eps))) return st;
+    json_t *o = json_object_get(v, "solver_opts");
+    join_path(p, sizeof p, path, "solver_opts");
+    if (o && (st = get_kv(m, o, p, MATRIX_SOLVER_OPTS, &r->solver_opts))) return st;
+    r->has = 1;
+    return MPM_OK;
+}
+
 static int resolve_dir(const Matrix *m, const char *path, const char *given, char *out, size_t n)
 {
     int w = given[0] == '/' ? snprintf(out, n, "%s", given) : snprintf(out, n, "%s/%s", m->dir, given);
@@ -207,12 +249,54 @@ static int resolve_dir(const Matrix *m, const char *path, const char *given, cha
     return MPM_OK;
 }
 
-/* defaults (every key) or a per-scene entry (scale, frames, first_timed_frame, set). */
+/* The run limits and accuracy settings: shared by defaults and per-scene
+ * entries. Returns 1 when key is one of them (st set), else 0. */
+static int get_run_setting(Matrix *m, const char *key, json_t *v, const char *p, MatrixSettings *s, int *st)
+{
+    if (!strcmp(key, "error_ref")) {
+        *st = get_error_ref(m, v, p, s->error_ref, sizeof s->error_ref);
+        s->has_error_ref = 1;
+    } else if (!strcmp(key, "trajectory")) {
+        *st = get_bool(m, v, p, &s->trajectory);
+        s->has_trajectory = 1;
+    } else if (!strcmp(key, "max_outer") || !strcmp(key, "max_linear")) {
+        int outer = !strcmp(key, "max_outer");
+        *st = get_int(m, v, p, 1, outer ? &s->max_outer : &s->max_linear);
+        if (outer) s->has_max_outer = 1;
+        else s->has_max_linear = 1;
+    } else if (!strcmp(key, "max_step_seconds") || !strcmp(key, "max_run_seconds")) {
+        int step = !strcmp(key, "max_step_seconds");
+        double *dst = step ? &s->max_step_s : &s->max_run_s;
+        *st = get_positive(m, v, p, dst);
+        if (!*st && *dst > 1e9) *st = bad_value(m, p, v, "seconds in (0, 1e9]");
+        if (step) s->has_max_step_s = 1;
+        else s->has_max_run_s = 1;
+    } else if (!strcmp(key, "on_failure")) {
+        *st = get_string(m, v, p, s->on_failure, sizeof s->on_failure);
+        if (!*st && strcmp(s->on_failure, "stop") && strcmp(s->on_failure, "continue"))
+            *st = bad_value(m, p, v, "\"stop\" or \"continue\"");
+        s->has_on_failure = 1;
+    } else if (!strcmp(key, "reference")) {
+        *st = get_reference(m, v, p, 1, &s->reference);
+        s->has_reference = 1;
+    } else {
+        return 0;
+    }
+    return 1;
+}
+
+/* defaults (every key) or a per-scene entry (scale, frames, first_timed_frame,
+ * set, the run limits, error_ref, reference). */
 static int get_settings(Matrix *m, json_t *obj, const char *path, int per_scene, MatrixSettings *s)
 {
-    static const char *const all[] = {"scene", "solver", "eps", "scale", "threads", "frames", "first_timed_frame",
-                                      "set", "solver_opts", "history", "armijo", "particles", "asset_dir", NULL};
-    static const char *const scene_keys[] = {"scale", "frames", "first_timed_frame", "set", NULL};
+    static const char *const all[] = {"scene",     "solver",     "eps",        "scale",           "threads",
+                                      "frames",    "first_timed_frame", "set", "solver_opts",     "history",
+                                      "armijo",    "particles",  "asset_dir",  "error_ref",       "trajectory",
+                                      "max_outer", "max_linear", "max_step_seconds", "max_run_seconds", "on_failure",
+                                      NULL};
+    static const char *const scene_keys[] = {"scale",      "frames",           "first_timed_frame", "set",
+                                             "error_ref",  "max_outer",        "max_linear",        "max_step_seconds",
+                                             "max_run_seconds", "on_failure",  "reference",         NULL};
     if (!json_is_object(obj)) return bad_value(m, path, obj, "an object");
     int st = check_keys(m, obj, path, per_scene ? scene_keys : all);
     if (st) return st;
@@ -221,6 +305,10 @@ static int get_settings(Matrix *m, json_t *obj, const char *path, int per_scene,
     json_object_foreach(obj, key, v) {
         char p[256];
         join_path(p, sizeof p, path, key);
+        if (get_run_setting(m, key, v, p, s, &st)) {
+            if (st) return st;
+            continue;
+        }
         if (!strcmp(key, "scene")) {
             st = get_scene(m, v, p, s->scene, sizeof s->scene);
             snprintf(s->scene_origin, sizeof s->scene_origin, "%s", p);
@@ -371,7 +459,8 @@ static int get_named_axes(Matrix *m, json_t *obj, const char *path, MatrixNamedK
 
 static int get_axes(Matrix *m, json_t *axes)
 {
-    static const char *const keys[] = {"scene", "solver", "eps", "scale", "threads", "sets", "solver_opts", NULL};
+    static const char *const keys[] = {"scene", "solver", "eps", "scale", "threads", "error_ref", "sets", "solver_opts",
+                                       NULL};
     if (!json_is_object(axes)) return bad_value(m, "axes", axes, "an object");
     int st = check_keys(m, axes, "axes", keys);
     if (st) return st;
@@ -415,6 +504,14 @@ static int get_axes(Matrix *m, json_t *axes)
             if ((st = get_int(m, json_array_get(v, i), p, 1, &m->threads[i]))) return st;
         }
     }
+    if ((v = json_object_get(axes, "error_ref"))) {
+        if ((st = get_list(m, v, "axes.error_ref", &n))) return st;
+        if (!(m->error_refs = calloc(n, sizeof *m->error_refs))) return mpm_error(MPM_EINTERNAL, "out of memory");
+        for (size_t i = 0; i < n; ++i, m->n_error_refs++) {
+            snprintf(p, sizeof p, "axes.error_ref[%zu]", i);
+            if ((st = get_error_ref(m, json_array_get(v, i), p, m->error_refs[i], sizeof m->error_refs[i]))) return st;
+        }
+    }
     if ((v = json_object_get(axes, "sets")) && (st = get_named_axes(m, v, "axes.sets", MATRIX_SET))) return st;
     if ((v = json_object_get(axes, "solver_opts")) &&
         (st = get_named_axes(m, v, "axes.solver_opts", MATRIX_SOLVER_OPTS)))
@@ -444,6 +541,12 @@ static int has_string_value(const Matrix *m, const char *key, const char *text)
             if (!strcmp(m->solvers[i], text)) return 1;
         return 0;
     }
+    if (!strcmp(key, "error_ref")) {
+        if (!m->n_error_refs) return m->defaults.has_error_ref && !strcmp(m->defaults.error_ref, text);
+        for (int i = 0; i < m->n_error_refs; ++i)
+            if (!strcmp(m->error_refs[i], text)) return 1;
+        return 0;
+    }
     const MatrixNamedAxis *a = &m->named[matrix_named_index(m, key)];
     for (int i = 0; i < a->n; ++i)
         if (!strcmp(a->values[i].label, text)) return 1;
@@ -462,7 +565,7 @@ static int check_rule_value(const Matrix *m, const char *key, json_t *v, const c
         return get_int(m, v, path, 1, &t);
     }
     char text[256];
-    if (json_is_number(v) && strcmp(key, "scene") && strcmp(key, "solver"))
+    if (json_is_number(v) && strcmp(key, "scene") && strcmp(key, "solver") && strcmp(key, "error_ref"))
         matrix_format_number(json_number_value(v), text, sizeof text);
     else if (!json_is_string(v))
         return bad_value(m, path, v, "a string (a value of that axis)");
@@ -486,11 +589,12 @@ static int get_rules(Matrix *m, json_t *rules, const char *path)
         json_object_foreach(r, key, v) {
             char p[160];
             snprintf(p, sizeof p, "%s.%s", rp, key);
-            static const char *const fixed[] = {"scene", "solver", "eps", "scale", "threads"};
+            static const char *const fixed[] = {"scene", "solver", "eps", "scale", "threads", "error_ref"};
             int known = matrix_named_index(m, key) >= 0;
-            for (int k = 0; k < 5; ++k) known |= !strcmp(key, fixed[k]);
+            for (int k = 0; k < 6; ++k) known |= !strcmp(key, fixed[k]);
             if (!known)
-                return mpm_error(MPM_EINPUT, "%s: %s: unknown axis \"%s\" (scene, solver, eps, scale, threads or a named axis)",
+                return mpm_error(MPM_EINPUT,
+                                 "%s: %s: unknown axis \"%s\" (scene, solver, eps, scale, threads, error_ref or a named axis)",
                                  m->base, rp, key);
             int st;
             if (json_is_array(v)) {
@@ -510,8 +614,8 @@ static int get_rules(Matrix *m, json_t *rules, const char *path)
 
 static int get_top(Matrix *m)
 {
-    static const char *const keys[] = {"name", "description", "defaults", "axes", "scenes", "include", "exclude",
-                                       "baseline", "cell_timeout_s", "report", NULL};
+    static const char *const keys[] = {"name",     "description",    "defaults", "axes",      "scenes", "include",
+                                       "exclude",  "baseline",       "cell_timeout_s", "report", "reference", NULL};
     json_t *root = m->root;
     if (!json_is_object(root)) return bad_value(m, "(top level)", root, "an object");
     int st = check_keys(m, root, "", keys);
@@ -547,6 +651,15 @@ static int get_top(Matrix *m)
             snprintf(ps->scene, sizeof ps->scene, "%s", scene);
             if ((st = get_settings(m, s, p, 1, &ps->s))) return st;
         }
+    }
+    if ((v = json_object_get(root, "reference")) && (st = get_reference(m, v, "reference", 0, &m->reference)))
+        return st;
+    m->has_references = m->reference.has;
+    m->uses_error_ref = m->defaults.has_error_ref || m->n_error_refs > 0;
+    for (int i = 0; i < m->n_per_scene; ++i) {
+        const MatrixSettings *ps = &m->per_scene[i].s;
+        m->uses_error_ref |= ps->has_error_ref;
+        m->has_references |= ps->has_reference && ps->reference.has;
     }
     if ((v = json_object_get(root, "include"))) {
         if ((st = get_rules(m, v, "include"))) return st;
@@ -599,6 +712,7 @@ void matrix_free(Matrix *m)
     free(m->eps);
     free(m->scales);
     free(m->threads);
+    free(m->error_refs);
     for (int i = 0; i < m->n_named; ++i) free(m->named[i].values);
     free(m->per_scene);
     json_decref(m->root);

@@ -26,15 +26,24 @@
  *     "armijo": false,              --armijo
  *     "particles": false,           --particles (PLY per frame; off by default
  *                                   so the timed window writes no particles)
- *     "asset_dir": "DIR"            --asset-dir; relative: from the matrix
+ *     "asset_dir": "DIR",           --asset-dir; relative: from the matrix
  *                                   file's directory (`matrix run --asset-dir`
  *                                   overrides it, relative to the working dir)
+ *     "error_ref": "auto",          --error-ref SOLVER[:eps] | auto[:eps]:
+ *                                   per-step error against a reference solve
+ *                                   (err_h, e_gap, err_v_max in steps.csv)
+ *     "trajectory": false,          --trajectory (OUT/trajectory.bin)
+ *     "max_outer": 10000,           --max-outer, integer >= 1
+ *     "max_linear": 10000,          --max-linear, integer >= 1
+ *     "max_step_seconds": 30,       --max-step-seconds, > 0
+ *     "max_run_seconds": 600,       --max-run-seconds, > 0
+ *     "on_failure": "stop"          --on-failure stop | continue
  *   },
  *   "axes": {                       optional: lists of values; the cells are
  *                                   their product. An axis replaces the
  *                                   defaults' value. No empty lists.
  *     "scene": ["bar3", ...], "solver": [...], "eps": [...], "scale": [...],
- *     "threads": [...],
+ *     "threads": [...], "error_ref": ["auto", "pn-pcg:1e-12"],
  *     "sets": {                     named axes of --set override sets, e.g.
  *       "stiffness": [{"materials.middle.E": 1e5}, {"materials.middle.E": 1e7}]
  *                                   a list (each set's label is its value when
@@ -48,7 +57,28 @@
  *   "scenes": {                     optional per-scene settings (key: a value
  *     "boxes": {"scale": 2.52, "frames": 9, "first_timed_frame": 4,
  *               "set": {...}}       of the scene axis); precedence:
- *   },                              defaults < scenes.NAME < axes
+ *   },                              defaults < scenes.NAME < axes. Also
+ *                                   allowed per scene: error_ref, the limits
+ *                                   (max_*, on_failure) and "reference"
+ *   "reference": {                  optional: a reference run per scene (the
+ *     "solver": "pn-cholmod",       trajectory error's reference, SPEC 11):
+ *     "eps": 1e-10,                 for every cell the runner derives a
+ *     "solver_opts": {...}          reference cell, the cell's settings with
+ *   },                              this solver (required), eps (default
+ *                                   1e-10) and solver_opts (replacing the
+ *                                   cell's), without error_ref, with
+ *                                   --trajectory. It runs first, as a cell of
+ *                                   its own (cells sharing the settings share
+ *                                   it), and its directory is passed to the
+ *                                   cell as --dt-from and --trajectory-ref;
+ *                                   the cell is started only after its
+ *                                   reference ended ok (also across resumes
+ *                                   and MPI ranks) and is skipped, without a
+ *                                   row, when it did not. scenes.NAME.reference
+ *                                   replaces it for a scene (false: none).
+ *                                   cells.csv then has the columns role
+ *                                   (cell | reference) and reference (the
+ *                                   reference cell's id)
  *   "include": [RULE, ...],         optional: keep only cells matching a rule
  *   "exclude": [RULE, ...],         optional: drop cells matching a rule
  *                                   RULE = {"scene": "bar3", "solver":
@@ -106,15 +136,30 @@ typedef struct {
     int n;
 } MatrixNamedAxis;
 
+/* The reference run of a scene ("reference"). */
+typedef struct {
+    int has;                  /* 0: none (absent, or false per scene) */
+    char solver[128];
+    double eps;
+    MatrixKvList solver_opts;
+    char origin[200];         /* where it was given, for messages */
+} MatrixReference;
+
 /* One optional setting (has = given). */
 typedef struct {
     int has_scene, has_solver, has_eps, has_scale, has_threads, has_frames, has_first, has_history, has_armijo,
-        has_particles, has_asset_dir;
+        has_particles, has_asset_dir, has_error_ref, has_trajectory, has_max_outer, has_max_linear, has_max_step_s,
+        has_max_run_s, has_on_failure, has_reference;
     char scene[1024], solver[128];
     char scene_origin[256], solver_origin[256];
     double eps, scale;
-    int threads, frames, first_timed_frame, history, armijo, particles;
+    int threads, frames, first_timed_frame, history, armijo, particles, trajectory;
     char asset_dir[1024];     /* absolute when given */
+    char error_ref[160];      /* SOLVER[:eps] | auto[:eps] */
+    int max_outer, max_linear;
+    double max_step_s, max_run_s;
+    char on_failure[16];      /* "stop" | "continue" */
+    MatrixReference reference;
     MatrixKvList set, solver_opts;
 } MatrixSettings;
 
@@ -139,6 +184,8 @@ typedef struct {
     int n_eps, n_scales;
     int *threads;
     int n_threads;
+    char (*error_refs)[160];
+    int n_error_refs;
     MatrixNamedAxis named[MATRIX_MAX_AXES];
     int n_named;
     MatrixSceneSettings *per_scene;
@@ -147,6 +194,9 @@ typedef struct {
     char baseline[128];           /* "" = none */
     double cell_timeout_s;        /* 0 = none */
     int report_mg_levels;
+    MatrixReference reference;    /* top-level "reference" */
+    int has_references;           /* some scene has a reference run */
+    int uses_error_ref;           /* error_ref given anywhere: a cells.csv column */
     json_t *root;                 /* the parsed file */
 } Matrix;
 

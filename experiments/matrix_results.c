@@ -63,7 +63,12 @@ int matrix_results_header(const Matrix *m, char *out, size_t cap)
                                         "first_timed_frame"};
     int bad = 0;
     for (int i = 0; i < 8; ++i) bad |= put(out, cap, &len, fixed[i], i == 0);
+    if (m->uses_error_ref) bad |= put(out, cap, &len, "error_ref", 0);
     for (int a = 0; a < m->n_named; ++a) bad |= put(out, cap, &len, m->named[a].name, 0);
+    if (m->has_references) {
+        bad |= put(out, cap, &len, "role", 0);
+        bad |= put(out, cap, &len, "reference", 0);
+    }
     bad |= put(out, cap, &len, "set", 0);
     bad |= put(out, cap, &len, "solver_opts", 0);
     bad |= len + strlen(cell_measure_columns) + 2 >= cap;
@@ -93,7 +98,12 @@ int matrix_results_row(const Matrix *m, const MatrixCell *c, const CellOutcome *
     int bad = 0;
     out[0] = '\0';
     for (int i = 0; i < 8; ++i) bad |= put(out, cap, &len, fixed[i], i == 0);
+    if (m->uses_error_ref) bad |= put(out, cap, &len, c->error_ref, 0);
     for (int a = 0; a < m->n_named; ++a) bad |= put(out, cap, &len, m->named[a].values[c->value[a]].label, 0);
+    if (m->has_references) {
+        bad |= put(out, cap, &len, c->is_reference ? "reference" : "cell", 0);
+        bad |= put(out, cap, &len, c->ref_id, 0);
+    }
     kv_join(c->set, c->n_set, text, sizeof text);
     bad |= put(out, cap, &len, text, 0);
     kv_join(c->solver_opts, c->n_solver_opts, text, sizeof text);

@@ -4,8 +4,11 @@
  * crash mid-write is dropped when the file is opened again). The header:
  *
  *   id, scene, solver, eps, scale, threads (0 = OpenMP's default),
- *   frames_asked (0 = the scene's), first_timed_frame, one column per named
- *   axis (its label), set and solver_opts (the merged "k=v;k=v" text), then
+ *   frames_asked (0 = the scene's), first_timed_frame, error_ref (only when
+ *   the matrix sets one), one column per named axis (its label), role (cell
+ *   | reference) and reference (the reference cell's id; both only when the
+ *   matrix has reference runs), set and solver_opts (the merged "k=v;k=v"
+ *   text), then
  *   cell_measure_columns (experiments/matrix_measure.h): status, exit,
  *   frames, steps, outer_iters, linear_iters, inner_iters, wall_s,
  *   timed_frames, timed_wall_s, s_per_frame, max_frame_s, max_residual,

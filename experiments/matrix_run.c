@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "experiments/matrix_cells.h"
+#include "experiments/matrix_check.h"
 #include "experiments/matrix_child.h"
 #include "experiments/matrix_dispatch.h"
 #include "experiments/matrix_file.h"
@@ -31,7 +32,7 @@ typedef struct {
     CellsFile results;
     char dir[1024];
     int *todo;             /* cell indices to run, in dispatch order */
-    int n_todo, n_done_before, n_finished;
+    int n_todo, n_done_before, n_finished, n_skipped;
     int n_status[5];
     double t_start, last_tick;
     int terminal, tick_shown;
@@ -54,6 +55,8 @@ static int select_cells(Run *r, const MatrixRunOptions *o)
     int *keep = calloc((size_t)r->cells.n + 1, sizeof *keep);
     if (!keep) return mpm_error(MPM_EINTERNAL, "out of memory");
     for (int i = 0; i < r->cells.n; ++i) keep[i] = matches_only(&r->cells.cells[i], o);
+    for (int i = 0; i < r->cells.n; ++i) /* a selected cell needs its reference run */
+        if (keep[i] && r->cells.cells[i].ref >= 0) keep[r->cells.cells[i].ref] = 1;
     matrix_cells_keep(&r->cells, keep);
     free(keep);
     if (!r->cells.n) return mpm_error(MPM_EINPUT, "--only %s: no cell of %s matches", o->only[0], r->m.base);
@@ -198,40 +201,105 @@ static void order_by_estimate(Run *r)
     free(est);
 }
 
+/* The cells.csv status of a cell done before this invocation ("" if none). */
+static const char *done_status(const Run *r, const char *id)
+{
+    const CsvTable *t = &r->results.rows;
+    int cid = csv_col(t, "id"), cst = csv_col(t, "status");
+    const char *s = "";
+    for (int i = 0; i < t->n_rows; ++i)
+        if (!strcmp(csv_get(t, i, cid), id)) s = csv_get(t, i, cst);
+    return s;
+}
+
+static void print_skip(const Run *r, const MatrixCell *c, const MatrixCell *ref, const char *why)
+{
+    char name[1200], desc[1024];
+    matrix_cell_name(c, name, sizeof name);
+    matrix_cell_describe(&r->m, c, desc, sizeof desc);
+    printf("[skipped] %s %s %s: its reference run %s %s\n", c->id, name, desc, ref->id, why);
+    fflush(stdout);
+}
+
+static void skipped(void *ctx, const MatrixTask *t, const MatrixTask *dep)
+{
+    Run *r = ctx;
+    r->n_skipped++;
+    clear_tick(r);
+    print_skip(r, &r->cells.cells[t->index], &r->cells.cells[dep ? dep->index : t->index],
+               dep ? "did not end ok (see cells.csv)" : "did not run");
+}
+
 static int build_tasks(Run *r, MatrixTask **out)
 {
     MatrixTask *t = calloc((size_t)(r->n_todo + 1), sizeof *t);
-    if (!t) return mpm_error(MPM_EINTERNAL, "out of memory (%d tasks)", r->n_todo);
+    int *pos = malloc(sizeof(int) * (size_t)(r->cells.n + 1)); /* cell index -> task position */
+    if (!t || !pos) {
+        free(t);
+        free(pos);
+        return mpm_error(MPM_EINTERNAL, "out of memory (%d tasks)", r->n_todo);
+    }
+    for (int i = 0; i < r->cells.n; ++i) pos[i] = -1;
+    for (int k = 0; k < r->n_todo; ++k) pos[r->todo[k]] = k;
+    int n = 0;
     for (int k = 0; k < r->n_todo; ++k) {
         const MatrixCell *c = &r->cells.cells[r->todo[k]];
-        t[k].index = r->todo[k];
-        t[k].first_timed_frame = c->first_timed_frame;
-        t[k].timeout_s = c->timeout_s;
-        int w = snprintf(t[k].dir, sizeof t[k].dir, "%s/cells/%s", r->dir, c->id);
+        t[n].after = c->ref >= 0 ? pos[c->ref] : -1;
+        if (c->ref >= 0 && pos[c->ref] < 0) { /* the reference was done before: only an ok one serves */
+            const char *s = done_status(r, r->cells.cells[c->ref].id);
+            if (strcmp(s, "ok") != 0) {
+                char why[64];
+                snprintf(why, sizeof why, "ended %s in an earlier run (see cells.csv)", s);
+                print_skip(r, c, &r->cells.cells[c->ref], why);
+                r->n_skipped++;
+                continue;
+            }
+        }
+        t[n].index = r->todo[k];
+        t[n].first_timed_frame = c->first_timed_frame;
+        t[n].timeout_s = c->timeout_s;
+        int w = snprintf(t[n].dir, sizeof t[n].dir, "%s/cells/%s", r->dir, c->id);
         int st = w < 0 || (size_t)w >= sizeof t[k].dir ? mpm_error(MPM_EINPUT, "%s: output path too long", r->dir) : MPM_OK;
-        if (!st) st = matrix_cell_argv(&r->m, c, t[k].dir, t[k].args, sizeof t[k].args, &t[k].argc);
+        if (!st) st = matrix_cell_argv(&r->m, c, t[n].dir, t[n].args, sizeof t[n].args, &t[n].argc);
         if (st) {
             free(t);
+            free(pos);
             return st;
         }
         size_t len = 0;
-        for (int a = 0; a < t[k].argc; ++a) len += strlen(t[k].args + len) + 1;
-        t[k].args_len = (int)len;
+        for (int a = 0; a < t[n].argc; ++a) len += strlen(t[n].args + len) + 1;
+        t[n].args_len = (int)len;
+        n++;
     }
+    /* positions shift past skipped tasks: remap the dependencies */
+    for (int k = 0; k < r->cells.n; ++k) pos[k] = -1;
+    for (int k = 0; k < n; ++k) pos[t[k].index] = k;
+    for (int k = 0; k < n; ++k) {
+        const MatrixCell *c = &r->cells.cells[t[k].index];
+        t[k].after = c->ref >= 0 ? pos[c->ref] : -1;
+    }
+    free(pos);
+    r->n_todo = n;
     *out = t;
     return MPM_OK;
 }
 
-/* A named-axis column new to cells.csv: the label of the cell with that id. */
+/* A column new to cells.csv (a named axis, error_ref, role, reference): the
+ * value of the cell with that id. */
 static int fill_column(void *ctx, const char *id, const char *column, char *out, size_t cap)
 {
     const Run *r = ctx;
     int a = matrix_named_index(&r->m, column);
-    for (int i = 0; i < r->cells.n && a >= 0; ++i)
-        if (!strcmp(r->cells.cells[i].id, id)) {
-            snprintf(out, cap, "%s", r->m.named[a].values[r->cells.cells[i].value[a]].label);
-            return 1;
-        }
+    for (int i = 0; i < r->cells.n; ++i) {
+        const MatrixCell *c = &r->cells.cells[i];
+        if (strcmp(c->id, id)) continue;
+        if (a >= 0) snprintf(out, cap, "%s", r->m.named[a].values[c->value[a]].label);
+        else if (!strcmp(column, "error_ref")) snprintf(out, cap, "%s", c->error_ref);
+        else if (!strcmp(column, "role")) snprintf(out, cap, "%s", c->is_reference ? "reference" : "cell");
+        else if (!strcmp(column, "reference")) snprintf(out, cap, "%s", c->ref_id);
+        else return 0;
+        return 1;
+    }
     return 0;
 }
 
@@ -346,7 +414,7 @@ int matrix_run(const char *file, const MatrixRunOptions *o)
         MPI_Abort(MPI_COMM_WORLD, 1);
     }
     if (go) {
-        MatrixDispatchHooks hooks = {cell_done, tick, &r};
+        MatrixDispatchHooks hooks = {cell_done, tick, skipped, &r};
         st = matrix_dispatch(tasks, rank == 0 ? r.n_todo : 0, o->jobs, use_mpi, &hooks);
         if (st && use_mpi) { /* the other ranks would wait for ever */
             fprintf(stderr, "mpmbench: error (rank %d): %s\n", rank, mpm_last_error());
@@ -357,6 +425,12 @@ int matrix_run(const char *file, const MatrixRunOptions *o)
             printf("matrix %s: %d cells ran (%d ok, %d bad-input, %d failed, %d crashed, %d timeout) in %.3f s; %s/cells.csv\n",
                    r.m.name, r.n_finished, r.n_status[CELL_OK], r.n_status[CELL_BAD_INPUT], r.n_status[CELL_FAILED],
                    r.n_status[CELL_CRASHED], r.n_status[CELL_TIMEOUT], matrix_now() - r.t_start, r.dir);
+            if (r.n_skipped)
+                printf("matrix %s: %d cells skipped: their reference run did not end ok\n", r.m.name, r.n_skipped);
+            int failed = 0;
+            if (!st && o->check && !(st = matrix_check_all(&r.m, &r.cells, r.dir, &failed)) && failed)
+                st = mpm_error(MPM_EINTERNAL, "matrix run --check: %d of %d cells failed (%s/check.csv)", failed,
+                               r.cells.n, r.dir);
         }
     }
     free(tasks);

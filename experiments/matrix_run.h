@@ -9,7 +9,12 @@
  * Output on stdout: one line per finished cell; on a terminal (stderr, CI
  * unset) also a progress line. Exit status 0 when the matrix ran (whatever
  * the cells' statuses: they are in cells.csv), 2 for a bad matrix file or
- * flag. */
+ * flag; with --check, 1 when a cell failed its check (matrix_check.h).
+ *
+ * A cell with a reference run (matrix_file.h "reference") is dispatched
+ * only after its reference ended ok; when the reference did not, the cell
+ * is skipped (no row: it stays to do) with one line saying why. --only
+ * keeps the references of the cells it selects. */
 #ifndef MPM_MATRIX_RUN_H
 #define MPM_MATRIX_RUN_H
 
@@ -21,6 +26,7 @@ typedef struct {
     int jobs;                         /* cells at a time per process (>= 1) */
     const char *asset_dir;            /* NULL: the matrix's */
     int threads;                      /* > 0: replaces defaults.threads (refused with a threads axis) */
+    int check;                        /* --check: the stability verdict of every cell (matrix_check.h) */
 } MatrixRunOptions;
 
 int matrix_run(const char *file, const MatrixRunOptions *o);

@@ -306,7 +306,7 @@ static void rc_hook(void *ctx, int iter, double elapsed, double residual, double
 static int simulate(Simulation *sim, Solver *solver, int frames, int *worst)
 {
     int status = MPM_OK;
-    StepWork work = {NULL, 0};
+    StepWork work = {.dv = NULL, .cap = 0};
     Progress prog;
     progress_init(&prog, frames);
     SolveSettings set;

@@ -16,6 +16,7 @@
 #include "experiments/progress.h"
 #include "experiments/provenance.h"
 #include "experiments/registry.h"
+#include "experiments/run_accuracy.h"
 #include "solvers/solver.h"
 
 #define RUN_MAX_SOLVER_OPTS 70
@@ -54,6 +55,12 @@ static int check_dir_arg(const char *flag, const char *path)
     return MPM_OK;
 }
 
+static AccuracyConfig accuracy_config(const RunConfig *cfg)
+{
+    AccuracyConfig a = {cfg->error_ref, cfg->dt_from, cfg->trajectory_ref, cfg->trajectory};
+    return a;
+}
+
 static int check_seconds(const char *flag, double v)
 {
     if (!(v >= 0.0) || !isfinite(v)) return mpm_error(MPM_EINPUT, "%s %g: expected a number of seconds >= 0", flag, v);
@@ -78,6 +85,8 @@ int run_config_check(const RunConfig *cfg)
     if ((st = solve_settings_check(&set))) return st;
     if ((st = check_dir_arg("--out", cfg->out_dir))) return st;
     if ((st = check_dir_arg("--particles", cfg->particles_dir))) return st;
+    AccuracyConfig acc = accuracy_config(cfg);
+    if ((st = run_accuracy_check(&acc))) return st;
     const char *opts[RUN_MAX_SOLVER_OPTS];
     int n = solver_option_list(cfg, opts);
     return solver_spec_check(cfg->solver, opts, n);
@@ -135,8 +144,9 @@ static void iter_hook(void *ctx, int iter, double elapsed, double residual, doub
 /* Records the exact configuration beside the tables, so every number says
  * how it was made (jansson escapes every string). */
 static void write_run_json(const char *dir, const RunConfig *cfg, const Scene *sc, const Solver *solver,
-                           const SolveSettings *set, int frames, int threads, int *status)
+                           const SolveSettings *set, const RunAccuracy *acc, int frames, int threads, int *status)
 {
+    AccuracyConfig ac = accuracy_config(cfg);
     const SolverOptions *so = &solver->opts;
     json_t *opts = json_object(), *ovr = json_object();
     /* every option the solver consulted, with the value in effect (given or default) */
@@ -152,6 +162,7 @@ static void write_run_json(const char *dir, const RunConfig *cfg, const Scene *s
                              "solver_options", opts, "overrides", ovr, "eps", cfg->eps, "scale", cfg->scale, "dx",
                              sc->dx, "frames", frames, "threads", threads, "line_search", solver->ls->name, "limits",
                              limits, "particles", (json_int_t)sc->particles.n);
+    if (root) json_object_set_new(root, "accuracy", (json_t *)run_accuracy_json(&ac, acc));
     if (root) json_object_set_new(root, "startup_s", json_real(library_startup_seconds()));
     if (root) json_object_set_new(root, "provenance", provenance_json(threads, 0));
     char path[1200];
@@ -201,6 +212,10 @@ int run_step(Simulation *sim, Solver *solver, const SolveSettings *set, StepWork
     if ((status = solver_solve(solver, &sim->pb, set, w->dv, ss, hook, hook_ctx))) return status;
     double t2 = omp_get_wtime();
     if (ss->status != SOLVE_FAILED || apply_failed) {
+        if (w->after_solve) {
+            if ((status = w->after_solve(w->after_solve_ctx, &sim->pb, w->dv))) return status;
+            info->after_solve_s = omp_get_wtime() - t2;
+        }
         SolveStats end = {0};
         status = breakdown(step_end(sim, w->dv), &end);
         if (status) return status;
@@ -212,8 +227,8 @@ int run_step(Simulation *sim, Solver *solver, const SolveSettings *set, StepWork
         }
     }
     double t3 = omp_get_wtime();
-    info->wall_s = t3 - t0;
-    info->end_s = t3 - t2;
+    info->wall_s = t3 - t0 - info->after_solve_s;
+    info->end_s = t3 - t2 - info->after_solve_s;
     return MPM_OK;
 }
 
@@ -251,7 +266,11 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     if (cfg->threads > 0) omp_set_num_threads(cfg->threads);
     int threads = omp_get_max_threads();
     /* MPI, hypre, CHOLMOD, the thread team: started (and timed) here, not in the first step */
-    if ((status = library_startup(solver))) {
+    AccuracyConfig acfg = accuracy_config(cfg);
+    RunAccuracy acc;
+    memset(&acc, 0, sizeof acc);
+    if ((status = library_startup(solver)) || (status = run_accuracy_create(&acfg, &acc))) {
+        run_accuracy_free(&acc);
         solver_destroy(solver);
         return status;
     }
@@ -259,10 +278,18 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     Scene scene;
     SceneLoadOptions lo = {cfg->scale, cfg->overrides, cfg->n_overrides, cfg->asset_dir};
     if ((status = scene_load(cfg->scene, &lo, &scene))) {
+        run_accuracy_free(&acc);
         solver_destroy(solver);
         return status;
     }
     int frames = cfg->frames > 0 ? cfg->frames : scene.frames;
+    /* the reference runs match this scene: checked before the output folder is made */
+    if ((status = run_accuracy_bind(&acfg, &scene, frames, &acc))) {
+        run_accuracy_free(&acc);
+        solver_destroy(solver);
+        scene_free(&scene);
+        return status;
+    }
 
     char out_dir[1024];
     if (cfg->out_dir) snprintf(out_dir, sizeof out_dir, "%s", cfg->out_dir);
@@ -270,19 +297,22 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     Simulation sim;
     memset(&sim, 0, sizeof sim);
     FILE *steps_csv = NULL, *frames_csv = NULL, *iters_csv = NULL;
-    StepWork work = {NULL, 0};
+    StepWork work = {.dv = NULL, .cap = 0};
     if ((status = mkdir_p(out_dir))) goto done;
     if (cfg->particles_dir && (status = mkdir_p(cfg->particles_dir))) goto done;
     if (!(steps_csv = open_in(out_dir, "steps.csv", &status))) goto done;
     if (!(frames_csv = open_in(out_dir, "frames.csv", &status))) goto done;
     if (cfg->history && !(iters_csv = open_in(out_dir, "iters.csv", &status))) goto done;
-    write_run_json(out_dir, cfg, &scene, solver, &set, frames, threads, &status);
+    if ((status = run_accuracy_open(&acc, out_dir, &scene))) goto done;
+    write_run_json(out_dir, cfg, &scene, solver, &set, &acc, frames, threads, &status);
     if (status) goto done;
     fprintf(steps_csv, "scene,solver,frame,step,t,dt,particles,active_nodes,hessian_blocks,outer_iters,linear_iters,"
                        "ls_evals,residual,status,wall_s,p2g_s,assemble_s,setup_s,solve_s,linesearch_s,g2p_s,threads,"
-                       "inner_iters,reason\n");
+                       "inner_iters,max_energy_rise,%s,reason\n",
+            run_accuracy_step_header);
     fprintf(frames_csv,
-            "scene,solver,frame,steps,outer_iters,linear_iters,wall_s,max_residual,status,threads,inner_iters,reason\n");
+            "scene,solver,frame,steps,outer_iters,linear_iters,wall_s,max_residual,status,threads,inner_iters,%s,reason\n",
+            run_accuracy_frame_header);
     if (iters_csv) fprintf(iters_csv, "frame,step,iter,elapsed_s,residual,energy\n");
 
     if ((status = sim_init(&sim, &scene))) goto done;
@@ -293,6 +323,7 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     if (!cfg->quiet) {
         printf("scene %s (%zu particles, dx %.4g m), solver %s, eps %.1e, %d threads\n", scene.name, scene.particles.n,
                scene.dx, solver->name, cfg->eps, threads);
+        if (acc.ref) printf("error reference: %s (its time is in ref_s, not in the timings)\n", error_ref_describe(acc.ref));
         printf("%6s %6s %8s %9s %9s %10s %12s  %s\n", "frame", "steps", "outer", "linear", "inner", "wall_s",
                "max_resid", "status");
     }
@@ -310,17 +341,22 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
             hook.step = fsteps;
             hook.fraction = (frame + sim.t_in_frame / sim.frame_dt) / frames;
             set_deadline(cfg, run_t0, &set, deadline_why, sizeof deadline_why);
+            if ((status = run_accuracy_before_step(&acc, &sim, fsteps, &work))) goto done;
             SolveStats ss;
             StepInfo si;
             if ((status = run_step(&sim, solver, &set, &work, iter_hook, &hook, cfg->on_failure == RUN_CONTINUE, &ss,
                                    &si)))
                 goto done;
-            fprintf(steps_csv, "%s,%s,%d,%d,%.9g,%.9g,%zu,%d,%lld,%d,%ld,%d,%.6e,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%ld,",
+            run_t0 += si.after_solve_s; /* the reference solve is not the run's time either */
+            /* t and dt read back as the same doubles (--dt-from replays them) */
+            fprintf(steps_csv, "%s,%s,%d,%d,%.17g,%.17g,%zu,%d,%lld,%d,%ld,%d,%.6e,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%ld,",
                     scene.name, solver->name, frame, fsteps, si.t, si.dt, sim.p.n, si.active_nodes,
                     (long long)ss.hessian_blocks, ss.outer_iters, ss.linear_iters, ss.ls_evals, ss.residual,
                     solve_status_name(ss.status), si.wall_s, si.begin_s, ss.assemble_s, ss.setup_s, ss.solve_s,
                     ss.linesearch_s, si.end_s, threads, ss.inner_iters);
-            csv_text(steps_csv, ss.reason);
+            fprintf(steps_csv, "%.9g,", ss.energy_increase_max);
+            run_accuracy_step_fields(steps_csv, &acc);
+            csv_text(steps_csv, ss.reason); /* the reason stays the last field */
             fputc('\n', steps_csv);
             fsteps++;
             fouter += ss.outer_iters;
@@ -349,8 +385,10 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
         }
         fprintf(frames_csv, "%s,%s,%d,%d,%ld,%ld,%.6f,%.6e,%s,%d,%ld,", scene.name, solver->name, frame, fsteps, fouter,
                 flinear, fwall, fmaxres, solve_status_name((SolveStatus)fstatus), threads, finner);
+        int acc_status = run_accuracy_frame_end(&acc, &sim, frame, fsteps, sim.frame > frame, frames_csv);
         csv_text(frames_csv, freason);
         fputc('\n', frames_csv);
+        if ((status = acc_status)) goto done;
         fflush(steps_csv);
         fflush(frames_csv);
         progress_clear(&prog);
@@ -408,6 +446,7 @@ done:
     if (frames_csv) fclose(frames_csv);
     if (iters_csv) fclose(iters_csv);
     free(work.dv);
+    run_accuracy_free(&acc);
     sim_free(&sim);
     solver_destroy(solver);
     scene_free(&scene);

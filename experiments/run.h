@@ -39,6 +39,11 @@ typedef struct {
     double max_step_s;          /* a step's solve past this ends as timeout; the run goes on */
     double max_run_s;           /* past this the running step ends as timeout and the run stops */
     FailurePolicy on_failure;
+    /* accuracy (experiments/run_accuracy.h; NULL / 0 = off) */
+    const char *error_ref;      /* --error-ref SOLVER[:eps] | auto[:eps] */
+    const char *dt_from;        /* --dt-from RUN_DIR */
+    const char *trajectory_ref; /* --trajectory-ref RUN_DIR */
+    int trajectory;             /* --trajectory: OUT/trajectory.bin */
 } RunConfig;
 
 typedef struct {
@@ -53,9 +58,15 @@ typedef struct {
 
 /* One timestep: step_begin, the initial guess, the solve, step_end. dv grows
  * with the grid; its storage persists across calls (free *dv at the end). */
-typedef struct {
+typedef struct StepWork {
     double *dv;
     int cap;
+    /* optional (NULL = none): called after the solve and before step_end with
+     * the step problem and the solver's dv, when the step is applied (the
+     * reference solve of --error-ref). Its time is in no timing column
+     * (StepInfo.after_solve_s); it must leave the problem's iterate cache at dv. */
+    int (*after_solve)(void *ctx, StepProblem *pb, const double *dv);
+    void *after_solve_ctx;
 } StepWork;
 
 typedef struct {
@@ -63,6 +74,7 @@ typedef struct {
     int active_nodes;
     double wall_s;              /* the whole step */
     double begin_s, end_s;      /* step_begin (P2G, BCs) and step_end (G2P, ...) */
+    double after_solve_s;       /* the after-solve hook, not in wall_s or end_s */
     int advanced;               /* step_end ran: the simulation moved to the next step */
 } StepInfo;
 

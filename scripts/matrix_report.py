@@ -38,6 +38,15 @@ and against iterations for the cells run with history (first step of the
 first timed frame, HOT Figs. 16/17). With report.mg_levels in the matrix,
 also blocks per row per multigrid level (HOT Fig. 8) from mg_levels.csv.
 
+Accuracy (matrix_report_accuracy.py, beside this file): for cells run with
+error_ref or against a reference run, work-precision diagrams (wall time
+against the median per-step err_h and against the last frame's pos_rms, one
+PNG per case without eps, one line per solver), the time to reach err_h <=
+1e-4 / 1e-6 interpolated along eps, performance profiles at matched
+accuracy and wp.csv; with DIR/check.csv (matrix run --check) the case x
+solver pass/fail grid. Reference-run cells (cells.csv role "reference") are
+listed on their own, not as solvers of the cases.
+
 Exit status: 0, 2 for a directory without cells.csv/matrix.json, 1 when
 matplotlib is missing.
 """
@@ -50,7 +59,7 @@ import sys
 
 FIG_W, FIG_H, DPI = 8.0, 5.0, 100  # 800 x 500 pixels
 STATUS_RANK = {"converged": 0, "capped": 1, "stalled": 2, "timeout": 3, "failed": 4}
-CASE_SKIP = {"id", "solver", "set", "solver_opts"}  # not part of a case key
+CASE_SKIP = {"id", "solver", "set", "solver_opts", "role", "reference"}  # not part of a case key
 SMALL_COLUMNS = {"min_dt", "avg_dt", "max_residual"}  # written as %e in report.csv
 # A named axis called "solver_setting" holds settings that belong to a solver
 # rather than to the case (paired with solvers by include/exclude rules, e.g.
@@ -237,6 +246,36 @@ def save(fig, root, name):
     return path
 
 
+def profile_figure(plt, ratios, order):
+    """The step curves rho_s(tau) of a Dolan-More profile from {solver: [ratios]} (inf = never),
+    on a log2 tau axis; (None, None) with fewer than two solvers or no finite ratio."""
+    finite = [r for rs in ratios.values() for r in rs if math.isfinite(r)]
+    if len(order) < 2 or not finite:
+        return None, None
+    tau_max = max(2.0, max(finite) * 1.1)
+    fig, ax = new_figure(plt)
+    for s in order:
+        rs = sorted(ratios.get(s, []))
+        n = len(rs)
+        if not n:
+            continue
+        xs, ys = [1.0], [0.0]
+        for i, r in enumerate(rs):
+            if not math.isfinite(r):
+                break
+            xs += [r, r]
+            ys += [ys[-1], (i + 1) / n]
+        xs.append(tau_max)
+        ys.append(ys[-1])
+        ax.plot(xs, ys, label=s, lw=1.6)
+    ax.set_xscale("log", base=2)
+    ax.set_xlim(1.0, tau_max)
+    from matplotlib.ticker import ScalarFormatter
+    ax.xaxis.set_major_formatter(ScalarFormatter())
+    ax.set_ylim(0.0, 1.02)
+    return fig, ax
+
+
 def performance_profile(plt, root, cases, titles, order, md):
     """Dolan & More (2002): rho_s(tau) = share of cases with t_s <= tau * min_s t_s."""
     ratios = {s: [] for s in order}
@@ -255,30 +294,9 @@ def performance_profile(plt, root, cases, titles, order, md):
         w.writerow(["case", "solver", "ratio"])
         for case, s, r in rows:
             w.writerow([case, s, f"{r:.6f}" if math.isfinite(r) else "inf"])
-    finite = [r for rs in ratios.values() for r in rs if math.isfinite(r)]
-    if len(order) < 2 or not finite:
+    fig, ax = profile_figure(plt, ratios, order)
+    if fig is None:
         return
-    tau_max = max(2.0, max(finite) * 1.1)
-    fig, ax = new_figure(plt)
-    for s in order:
-        rs = sorted(ratios[s])
-        n = len(rs)
-        if not n:
-            continue
-        xs, ys = [1.0], [0.0]
-        for i, r in enumerate(rs):
-            if not math.isfinite(r):
-                break
-            xs += [r, r]
-            ys += [ys[-1], (i + 1) / n]
-        xs.append(tau_max)
-        ys.append(ys[-1])
-        ax.plot(xs, ys, label=s, lw=1.6)
-    ax.set_xscale("log", base=2)
-    ax.set_xlim(1.0, tau_max)
-    from matplotlib.ticker import ScalarFormatter
-    ax.xaxis.set_major_formatter(ScalarFormatter())
-    ax.set_ylim(0.0, 1.02)
     ax.set_xlabel("tau (s/frame within a factor tau of the best)")
     ax.set_ylabel("fraction of cases")
     ax.set_title(f"Performance profile over {len(cases)} cases")
@@ -467,6 +485,8 @@ def main(argv):
     except ImportError:
         die(f"{sys.executable} has no matplotlib (Debian: apt-get install python3-matplotlib)", 1)
     baseline = meta.get("baseline") or ""
+    references = [c for c in cells if c.row.get("role") == "reference"]
+    cells = [c for c in cells if c.row.get("role") != "reference"]
     cols = case_columns(cells)
     show = varying(cells, cols)
     cases = group_cases(cells, cols)
@@ -551,6 +571,18 @@ def main(argv):
                         for k, v in r.items()})
     performance_profile(plt, root, cases, titles, order, md)
     stiffness_plots(plt, root, cells, cols, meta, order, md)
+    sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+    import matrix_report_accuracy as accuracy
+    helpers = {"fmt": fmt, "markdown": markdown, "slug": slug, "save": save, "new_figure": new_figure,
+               "case_title": case_title, "varying": varying, "profile_figure": profile_figure}
+    accuracy.work_precision(plt, root, cells, cols, order, md, helpers)
+    accuracy.robustness(plt, root, md, order, helpers)
+    if references:
+        md.append("\n## Reference runs\n")
+        md.append("The runs the cells' trajectories are compared with (their dt sequence is replayed):\n")
+        md.append(markdown(["id", "scene", "solver", "eps", "status", "frames", "s/frame"],
+                           [(c.id, c.row.get("scene", ""), c.solver, c.row.get("eps", ""), c.status,
+                             len(c.frame_time), fmt(c.s_per_frame)) for c in references]))
     with open(os.path.join(root, "report.md"), "w") as f:
         f.write("\n".join(md) + "\n")
     print(f"wrote {root}/report.md, report.csv, profile.csv and {root}/figures/")

@@ -135,6 +135,8 @@ int solve_line_search(SolveCtx *c, const double *dv, const double *g, const doub
     LineSearchParams prm = {c->set->max_halvings};
     int status = c->ls->search(c->pb, dv, p, E0, g, gTp, &prm, dv_new, g_new, out);
     st->ls_evals += out->evals;
+    if (!status && !out->stalled && out->energy - E0 > st->energy_increase_max)
+        st->energy_increase_max = out->energy - E0; /* NaN never enters: a NaN energy fails the next stop test */
     if (!status && out->stalled) solve_end(st, SOLVE_STALLED, "%s", out->why);
     else if (!status && !out->have_gradient) problem_gradient(c->pb, dv_new, g_new);
     st->linesearch_s += omp_get_wtime() - t0;

@@ -64,6 +64,10 @@ typedef struct {
     SolveStatus status;
     char reason[256];     /* why the solve did not converge ("" when it did) */
     double assemble_s, setup_s, solve_s, linesearch_s;
+    /* the largest E(accepted) - E(previous iterate) over the line searches of
+     * the solve (solve_line_search), 0 when none rose: > 0 means a strategy
+     * accepted an energy increase (the stress suite's check) */
+    double energy_increase_max;
     int64_t hessian_blocks;
     size_t hessian_bytes;
 } SolveStats;

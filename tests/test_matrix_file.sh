@@ -75,7 +75,26 @@ bad set-path 'set-path\.json: scene "drop" \(axes\.scene\[0\]\) at scale 3 with 
 bad set-value 'set-value\.json: scene "drop" .* with set materials\.soft\.E=-5 .*materials\.soft\.E' \
   '{"name": "t", "defaults": {"scale": 3}, "axes": {"scene": ["drop"], "solver": ["hot"], "sets": {"e": [{"materials.soft.E": -5}]}}}'
 expect_input_error 'matrix run: unknown option .--frames.' matrix run "$tmp/unknown-top.json" --frames 2
-expect_input_error 'matrix run --check: reserved' matrix run "$tmp/unknown-top.json" --check
+expect_input_error 'unknown-top\.json: frame: unknown key' matrix run "$tmp/unknown-top.json" --check
+# the accuracy and limit keys (issue 10)
+bad error-ref 'error-ref\.json: defaults\.error_ref: --error-ref pn-pgc: .*unknown solver' \
+  '{"name": "t", "defaults": {"error_ref": "pn-pgc"}, "axes": {"scene": ["drop"], "solver": ["hot"]}}'
+bad error-ref-eps 'error-ref-eps\.json: axes\.error_ref\[1\]: --error-ref auto:-1: eps -1' \
+  '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hot"], "error_ref": ["auto", "auto:-1"]}}'
+bad max-outer 'max-outer\.json: defaults\.max_outer: expected an integer >= 1, got 0' \
+  '{"name": "t", "defaults": {"max_outer": 0}, "axes": {"scene": ["drop"], "solver": ["hot"]}}'
+bad max-step 'max-step\.json: scenes\.drop\.max_step_seconds: expected a positive number, got -1' \
+  '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hot"]}, "scenes": {"drop": {"max_step_seconds": -1}}}'
+bad on-failure 'on-failure\.json: defaults\.on_failure: expected "stop" or "continue", got "retry"' \
+  '{"name": "t", "defaults": {"on_failure": "retry"}, "axes": {"scene": ["drop"], "solver": ["hot"]}}'
+bad reference-solver 'reference-solver\.json: reference\.solver: missing' \
+  '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hot"]}, "reference": {"eps": 1e-9}}'
+bad reference-key 'reference-key\.json: reference\.frames: unknown key' \
+  '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hot"]}, "reference": {"solver": "pn-pcg", "frames": 2}}'
+bad reference-false 'reference-false\.json: reference: expected an object' \
+  '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hot"]}, "reference": false}'
+bad reference-opt 'reference-opt\.json: solver "pn-pcg" \(reference\.solver\) with solver options window=4' \
+  '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hot"]}, "reference": {"solver": "pn-pcg", "solver_opts": {"window": 4}}}'
 expect_input_error '--jobs .0.: expected an integer' matrix run "$tmp/unknown-top.json" --jobs 0
 expect_input_error 'no-such\.json: cannot read matrix file' matrix run "$tmp/no-such.json"
 expect_input_error "matrix 'go': expected 'run' or 'report'" matrix go

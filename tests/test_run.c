@@ -57,7 +57,7 @@ static void breakdown_policy(void)
     solve_settings_default(&set);
     for (int apply = 0; apply < 2 && !st; ++apply) {
         Simulation sim;
-        StepWork w = {NULL, 0};
+        StepWork w = {.dv = NULL, .cap = 0};
         SolveStats ss;
         StepInfo si;
         st = sim_init(&sim, &sc);

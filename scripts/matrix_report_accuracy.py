@@ -1,0 +1,289 @@
+"""The accuracy and robustness sections of `mpmbench matrix report` (imported
+by matrix_report.py; SPEC 11, issue 10).
+
+Work precision, for cells whose steps.csv has err_h (run with error_ref) or
+whose frames.csv has pos_rms (run against a reference run):
+
+  * per cell: the median err_h, e_gap and the largest err_v_max over the
+    steps of the timed window, and pos_rms / pos_max / vel_rms at the last
+    frame; the time is the timed window's wall seconds (which exclude the
+    reference solves: they are ref_s);
+  * a work-precision case is a case without its eps: one line per solver
+    through its cells in eps order (cells that did not end ok are left out);
+  * figures/wp_NN_CASE.png: wall time against median err_h and against the
+    last frame's pos_rms, log-log, one line per solver;
+  * "time to reach err_h <= 1e-4 / 1e-6": along the solver's eps sequence
+    (loosest first), the first cell whose median err_h is at or below the
+    target, the time interpolated linearly in log(err_h)-log(time) between
+    it and the cell before it; "<= t" when the loosest eps already reaches
+    the target (it may be reached sooner), "not reached (best E)" when no
+    eps does;
+  * performance profiles at matched accuracy: each (case, target) is a
+    problem, a solver's cost its time to reach the target (not reached: never
+    within any factor); figures/profile_accuracy.png, profile_accuracy.csv;
+  * wp.csv: one row per cell with these numbers.
+
+Robustness, when DIR/check.csv exists (`matrix run --check`): a case x solver
+grid of pass / FAIL, the share of cases each solver passed, the reasons of
+every failing cell, and figures/robustness.png.
+"""
+import csv
+import math
+import os
+import statistics
+
+TARGETS = (1e-4, 1e-6)
+
+
+def _num(s):
+    try:
+        v = float(s)
+    except (TypeError, ValueError):
+        return float("nan")
+    return v
+
+
+def _finite(xs):
+    return [x for x in xs if math.isfinite(x)]
+
+
+def _read(path):
+    try:
+        with open(path, newline="") as f:
+            return list(csv.DictReader(f))
+    except OSError:
+        return None
+
+
+def cell_accuracy(cell):
+    """Sets the accuracy numbers of a report Cell from its steps.csv and frames.csv."""
+    steps = _read(os.path.join(cell.dir, "steps.csv")) or []
+    timed = [s for s in steps if _num(s.get("frame")) >= cell.first]
+    err = _finite([_num(s.get("err_h")) for s in timed])
+    gap = _finite([_num(s.get("e_gap")) for s in timed])
+    vmax = _finite([_num(s.get("err_v_max")) for s in timed])
+    cell.err_h = statistics.median(err) if err else float("nan")
+    cell.e_gap = statistics.median(gap) if gap else float("nan")
+    cell.err_v_max = max(vmax) if vmax else float("nan")
+    frames = _read(os.path.join(cell.dir, "frames.csv")) or []
+    last = max(frames, key=lambda f: _num(f.get("frame")), default={}) if frames else {}
+    cell.pos_rms = _num(last.get("pos_rms"))
+    cell.pos_max = _num(last.get("pos_max"))
+    cell.vel_rms = _num(last.get("vel_rms"))
+    cell.has_accuracy = bool(err) or math.isfinite(cell.pos_rms)
+
+
+def time_to_reach(points, target):
+    """points: [(eps, err, time)] of one solver; returns (time, mark): mark "" interpolated
+    or exact, "<=" reached at the loosest eps, None when not reached (time = best err)."""
+    pts = sorted((p for p in points if math.isfinite(p[1]) and math.isfinite(p[2]) and p[2] > 0),
+                 key=lambda p: -p[0])
+    if not pts:
+        return None, None
+    for k, (eps, err, t) in enumerate(pts):
+        if err > target:
+            continue
+        if k == 0:
+            return t, "<="
+        e0, t0 = pts[k - 1][1], pts[k - 1][2]
+        if err <= 0 or e0 <= 0 or e0 == err:
+            return t, ""
+        frac = (math.log(target) - math.log(e0)) / (math.log(err) - math.log(e0))
+        return math.exp(math.log(t0) + frac * (math.log(t) - math.log(t0))), ""
+    return min(p[1] for p in pts), None
+
+
+def _fmt_time(t, mark, fmt):
+    if mark is None:
+        return f"not reached (best {fmt(t)})" if t is not None else "-"
+    return f"{mark} {fmt(t)}".strip()
+
+
+def _profile(plt, root, problems, order, md, helpers):
+    """problems: {(case, target): {solver: time or inf}}; Dolan & More at matched accuracy."""
+    ratios = {s: [] for s in order}
+    rows = []
+    for (case, target), times in problems.items():
+        finite = [t for t in times.values() if math.isfinite(t)]
+        best = min(finite) if finite else math.inf
+        for s in order:
+            if s not in times:
+                continue
+            r = times[s] / best if math.isfinite(best) and best > 0 else math.inf
+            ratios[s].append(r)
+            rows.append((case, target, s, r))
+    with open(os.path.join(root, "profile_accuracy.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["case", "target_err_h", "solver", "ratio"])
+        for case, target, s, r in rows:
+            w.writerow([case, f"{target:g}", s, f"{r:.6f}" if math.isfinite(r) else "inf"])
+    fig, ax = helpers["profile_figure"](plt, ratios, order)
+    if fig is None:
+        return
+    ax.set_xlabel("tau (time to the target err_h within a factor tau of the best)")
+    ax.set_ylabel("fraction of (case, target) problems")
+    ax.set_title(f"Performance profile at matched accuracy ({len(problems)} problems: err_h <= "
+                 + ", ".join(f"{t:g}" for t in TARGETS) + ")", fontsize=9)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="lower right")
+    path = helpers["save"](fig, root, "profile_accuracy.png")
+    plt.close(fig)
+    md.append("\n### Performance profile at matched accuracy\n")
+    md.append("Each (case, target err_h) is a problem; a solver's cost is its time to reach the target "
+              "(not reached: never within any factor).\n")
+    md.append(f"![performance profile at matched accuracy]({path})\n")
+
+
+def _per_eps_table(lines, eps_values, value, fmt, markdown):
+    """One row per solver, one column per eps: value(cell), "-" where the solver has no cell."""
+    rows = []
+    for s, pts in lines.items():
+        by_eps = {_num(c.row.get("eps")): c for c in pts}
+        rows.append([s] + [fmt(value(by_eps[e])) if e in by_eps else "-" for e in eps_values])
+    return markdown(["solver"] + [f"eps {e:g}" for e in eps_values], rows)
+
+
+def work_precision(plt, root, cells, cols, order, md, helpers):
+    """The work-precision section (see the module's docstring)."""
+    fmt, markdown, slug, save, new_figure, case_title, varying = (
+        helpers["fmt"], helpers["markdown"], helpers["slug"], helpers["save"], helpers["new_figure"],
+        helpers["case_title"], helpers["varying"])
+    for c in cells:
+        cell_accuracy(c)
+    acc = [c for c in cells if c.has_accuracy]
+    if not acc:
+        return
+    rest = [k for k in cols if k != "eps"]
+    groups = {}
+    for c in acc:
+        groups.setdefault(tuple(c.row.get(k, "") for k in rest), []).append(c)
+    show = varying(acc, rest)
+    md.append("\n## Work precision\n")
+    md.append("Per-step error err_h = ||dv - dv*||_H / ||dv* - dv0||_H against the reference solve of the same "
+              "step problem (median over the timed steps), the last frame's particle position error pos_rms (in "
+              "dx) against the reference run, and the timed wall time, which excludes the reference solves "
+              "(their time is ref_s). Cells that did not end ok are left out.\n")
+    wp_rows, problems = [], {}
+    for i, (key, cs) in enumerate(sorted(groups.items())):
+        title = case_title(key, rest, show)
+        lines = {}
+        for s in order:
+            pts = sorted((c for c in cs if c.solver == s and c.status == "ok"), key=lambda c: -_num(c.row.get("eps")))
+            if pts:
+                lines[s] = pts
+        for c in cs:
+            wp_rows.append([title, c.solver, c.row.get("eps", ""), c.status, c.timed_wall, c.err_h, c.e_gap,
+                            c.err_v_max, c.pos_rms, c.pos_max, c.vel_rms])
+        if not lines:
+            continue
+        md.append(f"### {title}\n")
+        eps_values = sorted({_num(c.row.get("eps")) for c in cs}, reverse=True)
+        md.append("Median err_h per eps:\n")
+        md.append(_per_eps_table(lines, eps_values, lambda c: c.err_h, fmt, markdown))
+        if any(math.isfinite(c.pos_rms) for c in cs):
+            md.append("\nLast frame's pos_rms (dx) per eps:\n")
+            md.append(_per_eps_table(lines, eps_values, lambda c: c.pos_rms, fmt, markdown))
+        rows = []
+        for s, pts in lines.items():
+            line = [s]
+            for target in TARGETS:
+                t, mark = time_to_reach([(_num(c.row.get("eps")), c.err_h, c.timed_wall) for c in pts], target)
+                line.append(_fmt_time(t, mark, fmt))
+                problems.setdefault((title, target), {})[s] = t if mark is not None else math.inf
+            rows.append(line)
+        md.append("\nWall seconds (timed window) to reach a median err_h, interpolated in log-log along eps:\n")
+        md.append(markdown(["solver"] + [f"err_h <= {t:g}" for t in TARGETS], rows))
+        fig, (a1, a2) = new_figure(plt, 2)
+        for s, pts in lines.items():
+            e = [(c.err_h, c.timed_wall) for c in pts if math.isfinite(c.err_h) and c.err_h > 0]
+            p = [(c.pos_rms, c.timed_wall) for c in pts if math.isfinite(c.pos_rms) and c.pos_rms > 0]
+            if e:
+                a1.plot([x for x, _ in e], [y for _, y in e], marker="o", ms=3, label=s)
+            if p:
+                a2.plot([x for x, _ in p], [y for _, y in p], marker="o", ms=3, label=s)
+        for a, lab in ((a1, "median err_h per step"), (a2, "pos_rms at the last frame [dx]")):
+            a.set_xscale("log")
+            a.set_yscale("log")
+            a.set_xlabel(lab)
+            a.set_ylabel("wall seconds (timed window)")
+            a.grid(True, alpha=0.3, which="both")
+        if a1.lines:
+            for target in TARGETS:
+                a1.axvline(target, ls="--", color="0.6", lw=0.8)
+            a1.legend(fontsize=7)
+        elif a2.lines:
+            a2.legend(fontsize=7)
+        for a in (a1, a2):
+            if not a.lines:
+                a.text(0.5, 0.5, "no positive errors", ha="center", va="center", transform=a.transAxes)
+        fig.suptitle(f"Work precision: {title}", fontsize=10)
+        fig.tight_layout()
+        path = save(fig, root, f"wp_{i:02d}_{slug(title)}.png")
+        plt.close(fig)
+        md.append(f"\n![work precision, {title}]({path})\n")
+    with open(os.path.join(root, "wp.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["case", "solver", "eps", "status", "wall_s", "err_h_median", "e_gap_median", "err_v_max",
+                    "pos_rms_last", "pos_max_last", "vel_rms_last"])
+        for r in wp_rows:
+            w.writerow([f"{x:.9g}" if isinstance(x, float) and math.isfinite(x) else
+                        "" if isinstance(x, float) else x for x in r])
+    if problems:
+        _profile(plt, root, problems, order, md, helpers)
+
+
+def robustness(plt, root, md, order, helpers):
+    """The pass/fail grid of DIR/check.csv (matrix run --check)."""
+    rows = _read(os.path.join(root, "check.csv"))
+    if not rows:
+        return
+    markdown, save, new_figure = helpers["markdown"], helpers["save"], helpers["new_figure"]
+    fixed = {"id", "solver", "pass", "reasons"}
+    keys = [k for k in rows[0] if k not in fixed]
+    keys = [k for k in keys if k == "scene" or len({r.get(k, "") for r in rows}) > 1]
+    grid, cases = {}, []
+    for r in rows:
+        case = " ".join([r.get("scene", "")] + [f"{k}={r[k]}" for k in keys if k != "scene"])
+        if case not in cases:
+            cases.append(case)
+        grid[(case, r["solver"])] = r
+    solvers = [s for s in order if any((c, s) in grid for c in cases)]
+    solvers += sorted({r["solver"] for r in rows} - set(solvers))
+    md.append("\n## Robustness (matrix run --check)\n")
+    md.append("Pass: every step converged (residual re-checked) or reported capped / stalled / timeout / failed, no "
+              "NaN or Inf in the outputs, no line search accepted an energy increase, the run ended inside its "
+              "wall-clock limit and particles stayed in the domain or the run said otherwise "
+              "(experiments/matrix_check.h).\n")
+    table = []
+    for case in cases:
+        line = [case]
+        for s in solvers:
+            r = grid.get((case, s))
+            line.append("-" if r is None else "pass" if r["pass"] == "1" else "**FAIL**")
+        table.append(line)
+    passed = [sum(1 for c in cases if grid.get((c, s), {}).get("pass") == "1") for s in solvers]
+    total = [sum(1 for c in cases if (c, s) in grid) for s in solvers]
+    table.append(["**passed**"] + [f"{p}/{t}" for p, t in zip(passed, total)])
+    md.append(markdown(["case"] + solvers, table))
+    fails = [r for r in rows if r["pass"] != "1"]
+    if fails:
+        md.append("\nFailing cells:\n")
+        for r in fails:
+            case = " ".join([r.get("scene", "")] + [f"{k}={r[k]}" for k in keys if k != "scene"])
+            md.append(f"- {case} / {r['solver']} ({r['id']}): {r['reasons']}")
+        md.append("")
+    fig, ax = new_figure(plt)
+    import matplotlib.colors as mcolors
+    values = [[(1.0 if grid[(c, s)]["pass"] == "1" else 0.0) if (c, s) in grid else float("nan") for s in solvers]
+              for c in cases]
+    ax.imshow(values, aspect="auto", cmap=mcolors.ListedColormap(["#d62728", "#2ca02c"]), vmin=0, vmax=1,
+              interpolation="nearest")
+    ax.set_xticks(range(len(solvers)))
+    ax.set_xticklabels(solvers, rotation=30, ha="right", fontsize=7)
+    ax.set_yticks(range(len(cases)))
+    ax.set_yticklabels(cases, fontsize=max(4, min(8, int(300 / max(1, len(cases))))))
+    ax.set_title(f"Robustness: {sum(passed)} of {sum(total)} cells pass (green)", fontsize=10)
+    fig.tight_layout()
+    path = save(fig, root, "robustness.png")
+    plt.close(fig)
+    md.append(f"\n![robustness grid]({path})\n")
