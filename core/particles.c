@@ -68,6 +68,7 @@ static void permute_field(double *f, size_t width, size_t n, const size_t *perm,
 void particles_permute(Particles *p, const size_t *perm, double *scratch)
 {
     size_t n = p->n;
+    if (n == 0) return;
     permute_field(p->x, 3, n, perm, scratch);
     permute_field(p->v, 3, n, perm, scratch);
     permute_field(p->C, 9, n, perm, scratch);

@@ -48,13 +48,15 @@ static int file_exists(const char *p)
 
 static int cmp_str(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
 
-/* Sorted built-in names (without .json); caller frees each and the array. */
+/* Sorted built-in names (without .json); caller frees each and the array.
+ * Returns -1 without a message when the directory cannot be opened (the
+ * callers word it: listing fails, an unknown name says "none"). */
 static int list_names(char ***names_out, int *n_out)
 {
     *names_out = NULL;
     *n_out = 0;
     DIR *d = opendir(scene_dir());
-    if (!d) return mpm_error(MPM_EINPUT, "cannot open the scene directory %s (set MPM_SCENE_DIR)", scene_dir());
+    if (!d) return -1;
     char **names = NULL;
     int n = 0, cap = 0;
     struct dirent *e;
@@ -74,7 +76,7 @@ static int list_names(char ***names_out, int *n_out)
         ++n;
     }
     closedir(d);
-    qsort(names, (size_t)n, sizeof *names, cmp_str);
+    if (n > 1) qsort(names, (size_t)n, sizeof *names, cmp_str);
     *names_out = names;
     *n_out = n;
     return MPM_OK;
@@ -90,8 +92,8 @@ int scene_list(SceneListFn fn, void *ctx)
 {
     char **names;
     int n;
-    int st = list_names(&names, &n);
-    if (st) return st;
+    if (list_names(&names, &n))
+        return mpm_error(MPM_EINPUT, "cannot open the scene directory %s (set MPM_SCENE_DIR)", scene_dir());
     for (int k = 0; k < n; ++k) {
         char path[2048];
         snprintf(path, sizeof path, "%s/%s.json", scene_dir(), names[k]);
@@ -531,12 +533,8 @@ static int sample_objects(Scene *sc, const char *file, ObjectSpec *objs, int nob
         if (!st)
             st = sampler_sample(o->shape, o->sampling, sc->dx, o->ppc, rng_mix(sc->seed, 0x5A00ull + (uint64_t)i),
                                 tile, &pts);
-        if (st) {
-            /* re-issue the sampler's message with the place in the file */
-            char msg[900];
-            snprintf(msg, sizeof msg, "%s", mpm_last_error());
-            mpm_clear_error();
-            mpm_error(st, "%s: %s: %s", file, path, msg);
+        if (st) { /* the sampler's message, prefixed with the place in the file */
+            mpm_error_context(st, "%s: %s", file, path);
             break;
         }
         if (pts.n == 0) {
@@ -820,7 +818,7 @@ int scene_load(const char *name_or_path, const SceneLoadOptions *opt, Scene *out
             char **names;
             int n;
             char list[512] = "";
-            if (list_names(&names, &n) == MPM_OK) {
+            if (list_names(&names, &n) == 0) {
                 size_t used = 0;
                 for (int k = 0; k < n && used + 70 < sizeof list; ++k) {
                     int w = snprintf(list + used, sizeof list - used, "%s%s", k ? ", " : "", names[k]);
@@ -828,7 +826,6 @@ int scene_load(const char *name_or_path, const SceneLoadOptions *opt, Scene *out
                 }
                 free_names(names, n);
             }
-            mpm_clear_error(); /* a listing failure must not hide the real message */
             return mpm_error(MPM_EINPUT, "unknown scene \"%s\" (built-in scenes in %s: %s)", name_or_path,
                              scene_dir(), list[0] ? list : "none");
         }

@@ -762,13 +762,10 @@ static int parse_mesh(json_t *j, const char *file, const char *path, const char 
         st = mesh_load_obj_lenient(full, (int)mbe, &s->mesh);
     else
         st = mesh_load_obj(full, &s->mesh);
-    if (st) {
-        /* re-issue the loader's message with the place in the scene */
-        char p[512], msg[700];
+    if (st) { /* the loader's message, prefixed with the place in the scene */
+        char p[512];
         sj_path(p, sizeof p, path, "file");
-        snprintf(msg, sizeof msg, "%s", mpm_last_error());
-        mpm_clear_error();
-        return mpm_error(st, "%s: %s: %s", file, p, msg);
+        return mpm_error_context(st, "%s: %s", file, p);
     }
     return MPM_OK;
 #else

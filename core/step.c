@@ -15,6 +15,8 @@ static int copy_particles(Particles *dst, const Particles *src)
     if (st) return st;
     if (src->Jp && (st = particles_enable_plastic_state(dst))) return st;
     size_t n = src->n;
+    dst->n = n;
+    if (n == 0) return MPM_OK; /* a scene that starts empty (sources only): no arrays yet */
     memcpy(dst->x, src->x, sizeof(double) * 3 * n);
     memcpy(dst->v, src->v, sizeof(double) * 3 * n);
     memcpy(dst->C, src->C, sizeof(double) * 9 * n);
@@ -23,7 +25,6 @@ static int copy_particles(Particles *dst, const Particles *src)
     memcpy(dst->vol, src->vol, sizeof(double) * n);
     memcpy(dst->mat, src->mat, sizeof(int) * n);
     if (src->Jp) memcpy(dst->Jp, src->Jp, sizeof(double) * n);
-    dst->n = n;
     return MPM_OK;
 }
 
