@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/threads.h"
 #include "experiments/bench.h"
 #include "experiments/registry.h"
 #include "experiments/render_cmd.h"
@@ -93,8 +94,7 @@ static int parse_args(int argc, char **argv, int first, Args *a)
         else if (!strcmp(f, "--scale")) { NEED_VAL(); if ((st = parse_double(f, val, &c->scale))) return st; }
         else if (!strcmp(f, "--threads")) {
             NEED_VAL();
-            if ((st = parse_int(f, val, &c->threads))) return st;
-            if (c->threads < 1) return mpm_error(MPM_EINPUT, "--threads %d: expected >= 1", c->threads);
+            if ((st = threads_parse(f, val, &c->threads))) return st;
         } else if (!strcmp(f, "--out")) { NEED_VAL(); c->out_dir = val; }
         else if (!strcmp(f, "--particles")) { NEED_VAL(); c->particles_dir = val; }
         else if (!strcmp(f, "--asset-dir")) { NEED_VAL(); c->asset_dir = val; }
@@ -166,8 +166,9 @@ int main(int argc, char **argv)
         usage(argc < 2 ? stderr : stdout);
         return argc < 2 ? MPM_EINPUT : 0;
     }
-    int st;
-    if (!strcmp(argv[1], "list")) st = cmd_list(argc, argv);
+    int st = threads_check_env(); /* before OpenMP reads it at the first parallel region */
+    if (st) {
+    } else if (!strcmp(argv[1], "list")) st = cmd_list(argc, argv);
     else if (!strcmp(argv[1], "run")) st = cmd_run(argc, argv);
     else if (!strcmp(argv[1], "bench")) st = cmd_bench(argc, argv);
     else if (!strcmp(argv[1], "render")) st = render_command(argc, argv);

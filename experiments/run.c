@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "core/step.h"
+#include "experiments/paths.h"
 #include "experiments/ply.h"
 #include "experiments/progress.h"
 #include "experiments/registry.h"
@@ -119,6 +120,9 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
 {
     int status = MPM_OK;
     memset(sum, 0, sizeof *sum);
+    if ((status = paths_check_output_dir("--out", cfg->out_dir)) ||
+        (status = paths_check_output_dir("--particles", cfg->particles_dir)))
+        return status;
     const SolverPreset *preset = registry_find(cfg->solver);
     if (!preset) return mpm_error(MPM_EINPUT, "unknown solver '%s' (see: mpmbench list solvers)", cfg->solver);
     if (!(cfg->eps > 0.0) || !isfinite(cfg->eps)) return mpm_error(MPM_EINPUT, "--eps %g: expected a positive number", cfg->eps);
