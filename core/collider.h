@@ -121,8 +121,13 @@ int collider_active(const Collider *c, double t);
  * rigid speed |omega x r + v| is convex in x, so its maximum over a box is at
  * a corner. The box used is [lo, hi] intersected with the collider's current
  * world bounds when they overlap, else [lo, hi] itself. 0 when inactive;
- * "cfl_speed" when the collider has one. */
+ * "cfl_speed" when the collider has one. A NaN speed is returned as NaN. */
 double collider_max_speed(const Collider *c, double t, const double lo[3], const double hi[3]);
+
+/* The reference's variant of collider_max_speed (scene "cfl_rule":
+ * "reference", SPEC 12): also the speeds at the corners of the collider's
+ * own bounding box that pass the reference's any-axis overlap test. */
+double collider_max_speed_reference(const Collider *c, double t, const double lo[3], const double hi[3]);
 
 void collider_free(Collider *c);
 

@@ -5,6 +5,7 @@
 #include "core/scene.h"
 
 #include <dirent.h>
+#include <errno.h>
 #include <jansson.h>
 #include <math.h>
 #include <stdio.h>
@@ -114,8 +115,9 @@ int scene_list(SceneListFn fn, void *ctx)
  * ====================================================================== */
 
 /* Optional fields that --set may create when absent, by context. */
-static const char *const k_top_optional[] = {"description", "cfl",       "max_dt",  "apic_ratio", "domain_walls",
-                                             "seed",        "colliders", "sources", NULL};
+static const char *const k_top_optional[] = {"description", "cfl",     "max_dt",    "min_dt",  "cfl_rule",
+                                             "apic_ratio",  "domain_walls", "seed", "colliders", "sources",
+                                             NULL};
 static const char *const k_mat_optional[] = {"plasticity", NULL};
 static const char *const k_plast_optional[] = {"yield_stress", "theta_c", "theta_s", "hardening",
                                                "min_Jp",       "max_Jp",  NULL};
@@ -545,10 +547,16 @@ static int sample_objects(Scene *sc, const char *file, ObjectSpec *objs, int nob
         }
         double vol = shape_volume(o->shape);
         double vp = vol / (double)pts.n, mass = sc->materials[o->mat].density * vp;
-        if (!(vp > 0) || !isfinite(vp) || !(mass > 0) || !isfinite(mass)) {
+        /* a node's mass can be 1e-30 of a particle's (a B-spline weight near a
+         * stencil's edge): far smaller particle masses underflow to zero node
+         * masses and NaN velocities, far larger ones overflow the energy */
+        if (!(vp > 0) || !isfinite(vp) || !(mass >= 1e-200 && mass <= 1e200)) {
             sample_points_free(&pts);
-            st = mpm_error(MPM_EINPUT, "%s: %s: particle volume %g and mass %g are not positive and finite", file,
-                           path, vp, mass);
+            char mp[512];
+            sj_path(mp, sizeof mp, "materials", sc->materials[o->mat].name);
+            st = mpm_error(MPM_EINPUT,
+                           "%s: %s: particle volume %g m^3 and mass %g kg (%s.density %g) are not in [1e-200, 1e200]",
+                           file, path, vp, mass, mp, sc->materials[o->mat].density);
             break;
         }
         for (size_t k = 0; k < pts.n; ++k) {
@@ -642,12 +650,105 @@ static int parse_sources(Scene *sc, json_t *srcs, const char *file, const char *
  * Top level
  * ====================================================================== */
 
+/* Every collider's surface speed over the domain must be finite in each of
+ * its motion phases (an angular velocity of 1e308 deg/s overflows it), so
+ * the CFL rule always sees a number. The first n_scene colliders are the
+ * scene's "colliders" array, the rest come from "sources". */
+static int check_collider_speeds(const Scene *sc, const char *file, size_t n_scene)
+{
+    for (int c = 0; c < sc->n_colliders; ++c) {
+        const Collider *col = &sc->colliders[c];
+        for (int k = 0; k < col->n_phases; ++k) {
+            double t = col->phases[k].t_start;
+            double v = collider_max_speed(col, t, sc->domain_lo, sc->domain_hi);
+            if (isfinite(v)) continue;
+            char where[64];
+            if ((size_t)c < n_scene)
+                snprintf(where, sizeof where, "colliders.%d", c);
+            else
+                snprintf(where, sizeof where, "sources (collider %d)", c);
+            return mpm_error(MPM_EINPUT,
+                             "%s: %s.motion.%d: collider \"%s\" moves at a non-finite speed (%g m/s) over the domain "
+                             "from t = %g s: its velocity or angular_velocity_deg is too large",
+                             file, where, k, col->name, v, t);
+        }
+    }
+    return MPM_OK;
+}
+
+/* The grid must fit the domain: at least one cell across its smallest
+ * extent, and integer node coordinates (|x / dx| < 2^30) everywhere in it. */
+static int check_dx_against_domain(const Scene *sc, const char *file, double scale)
+{
+    double ext = HUGE_VAL, reach = 0.0;
+    for (int d = 0; d < 3; ++d) {
+        ext = fmin(ext, sc->domain_hi[d] - sc->domain_lo[d]);
+        reach = fmax(reach, fmax(fabs(sc->domain_lo[d]), fabs(sc->domain_hi[d])));
+    }
+    char what[200], times[64] = "";
+    if (scale != 1.0) snprintf(times, sizeof times, " (dx times --scale %g)", scale);
+    if (!(sc->dx <= ext)) {
+        snprintf(what, sizeof what, "expected at most the domain's smallest extent %g m%s", ext, times);
+        return sj_bad_number(file, "", "dx", what, sc->dx);
+    }
+    double lo = reach / 1073741824.0;
+    if (!(sc->dx >= lo)) {
+        snprintf(what, sizeof what, "expected at least %g m%s (grid coordinates |x / dx| < 2^30 over the domain)", lo,
+                 times);
+        return sj_bad_number(file, "", "dx", what, sc->dx);
+    }
+    return MPM_OK;
+}
+
+/* min_dt, max_dt and cfl_rule, validated against the frame length 1/fps (a
+ * frame of more than MAX_STEPS_PER_FRAME floor-sized steps is refused). */
+enum { MAX_STEPS_PER_FRAME = 1000000 };
+
+static int parse_time_steps(json_t *root, const char *file, Scene *sc)
+{
+    double frame = 1.0 / sc->fps;
+    char what[160];
+    sc->min_dt = 1e-6; /* the reference's floor (hot-algorithms.md 1.1) */
+    int have_min = 0;
+    int st = sj_positive(root, "min_dt", 0, file, "", &sc->min_dt, &have_min);
+    if (st) return st;
+    if (!have_min && !(sc->min_dt <= frame)) {
+        snprintf(what, sizeof what, "expected at most 1/min_dt = %.6g frames per second", 1.0 / sc->min_dt);
+        return sj_bad_number(file, "", "fps", what, sc->fps);
+    }
+    if (!(sc->min_dt * MAX_STEPS_PER_FRAME >= frame)) {
+        snprintf(what, sizeof what, "expected at least the frame length 1/fps = %.6g s / %d", frame,
+                 MAX_STEPS_PER_FRAME);
+        return sj_bad_number(file, "", "min_dt", what, sc->min_dt);
+    }
+    if (!(sc->min_dt <= frame)) {
+        snprintf(what, sizeof what, "expected at most the frame length 1/fps = %.6g s", frame);
+        return sj_bad_number(file, "", "min_dt", what, sc->min_dt);
+    }
+    sc->max_dt = frame;
+    if ((st = sj_positive(root, "max_dt", 0, file, "", &sc->max_dt, NULL))) return st;
+    if (!(sc->max_dt >= sc->min_dt)) {
+        snprintf(what, sizeof what, "expected at least min_dt = %.6g s (the smallest step)", sc->min_dt);
+        return sj_bad_number(file, "", "max_dt", what, sc->max_dt);
+    }
+    const char *rule = "paper";
+    int have = 0;
+    if ((st = sj_string(root, "cfl_rule", 0, file, "", &rule, &have))) return st;
+    if (strcmp(rule, "paper") == 0)
+        sc->cfl_rule = CFL_RULE_PAPER;
+    else if (strcmp(rule, "reference") == 0)
+        sc->cfl_rule = CFL_RULE_REFERENCE;
+    else
+        return sj_bad(file, "", "cfl_rule", "expected \"paper\" or \"reference\"", json_object_get(root, "cfl_rule"));
+    return MPM_OK;
+}
+
 static int build(json_t *root, const char *file, const SceneLoadOptions *opt, const char *asset_dir, Scene *sc)
 {
-    static const char *const keys[] = {"name",       "description", "dx",     "fps",          "frames",
-                                       "cfl",        "max_dt",      "gravity", "apic_ratio",  "domain",
-                                       "domain_walls", "seed",      "materials", "objects",   "colliders",
-                                       "sources",    NULL};
+    static const char *const keys[] = {"name",       "description", "dx",       "fps",        "frames",
+                                       "cfl",        "max_dt",      "min_dt",   "cfl_rule",   "gravity",
+                                       "apic_ratio", "domain",      "domain_walls", "seed",   "materials",
+                                       "objects",    "colliders",   "sources",  NULL};
     int st = sj_check_object(root, file, "", keys);
     if (st) return st;
     if ((st = read_name(root, "name", 1, file, "", sc->name, sizeof sc->name))) return st;
@@ -663,6 +764,8 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
     if (!(sc->dx > 0) || !isfinite(sc->dx))
         return mpm_error(MPM_EINPUT, "%s: dx: dx times --scale %g is not a positive finite number", file, scale);
     if ((st = sj_positive(root, "fps", 1, file, "", &sc->fps, NULL))) return st;
+    if (!isfinite(1.0 / sc->fps))
+        return sj_bad_number(file, "", "fps", "expected a frame rate whose frame length 1/fps is finite", sc->fps);
     double frames = 0;
     if ((st = sj_number(root, "frames", 1, file, "", &frames, NULL))) return st;
     if (!(frames >= 1 && frames <= 1e9 && frames == floor(frames)))
@@ -670,10 +773,7 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
     sc->frames = (int)frames;
     sc->cfl = 0.6;
     if ((st = sj_positive(root, "cfl", 0, file, "", &sc->cfl, NULL))) return st;
-    sc->max_dt = 1.0 / sc->fps;
-    if ((st = sj_positive(root, "max_dt", 0, file, "", &sc->max_dt, NULL))) return st;
-    if (!isfinite(sc->max_dt) || !(sc->max_dt > 0))
-        return sj_bad_number(file, "", "max_dt", "expected a positive number", sc->max_dt);
+    if ((st = parse_time_steps(root, file, sc))) return st;
     if ((st = sj_vec3(root, "gravity", 1, file, "", sc->gravity, NULL))) return st;
     sc->apic_ratio = 1.0;
     if ((st = sj_number(root, "apic_ratio", 0, file, "", &sc->apic_ratio, NULL))) return st;
@@ -687,10 +787,13 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
     if ((st = sj_vec3(dom, "min", 1, file, "domain", sc->domain_lo, NULL))) return st;
     if ((st = sj_vec3(dom, "max", 1, file, "domain", sc->domain_hi, NULL))) return st;
     for (int d = 0; d < 3; ++d)
-        if (!(sc->domain_hi[d] > sc->domain_lo[d]))
-            return sj_bad(file, "domain", "max", "expected max > min on every axis", json_object_get(dom, "max"));
+        if (!(sc->domain_hi[d] > sc->domain_lo[d]) || !isfinite(sc->domain_hi[d] - sc->domain_lo[d]))
+            return sj_bad(file, "domain", "max", "expected max > min on every axis (and a finite extent)",
+                          json_object_get(dom, "max"));
+    if ((st = check_dx_against_domain(sc, file, scale))) return st;
     int walls = 0;
     if ((st = sj_bool(root, "domain_walls", 0, file, "", &walls, NULL))) return st;
+    sc->domain_walls = walls;
     sc->seed = 1;
     json_t *seed = json_object_get(root, "seed");
     if (seed) {
@@ -759,6 +862,7 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
                                    sc->colliders[a].name);
                     break;
                 }
+        if (!st) st = check_collider_speeds(sc, file, nc);
         if (!st && walls) st = add_walls(sc, file);
     }
 
@@ -833,7 +937,12 @@ int scene_load(const char *name_or_path, const SceneLoadOptions *opt, Scene *out
         if (strlen(name_or_path) >= sizeof path)
             return mpm_error(MPM_EINPUT, "scene path too long: %.80s...", name_or_path);
         snprintf(path, sizeof path, "%s", name_or_path);
-        if (!file_exists(path)) return mpm_error(MPM_EINPUT, "%s: scene file not found", path);
+        struct stat sb;
+        if (stat(path, &sb) != 0) return mpm_error(MPM_EINPUT, "%s: scene file not found (%s)", path, strerror(errno));
+        if (S_ISDIR(sb.st_mode)) return mpm_error(MPM_EINPUT, "%s: is a directory, not a scene file", path);
+        if (!S_ISREG(sb.st_mode))
+            return mpm_error(MPM_EINPUT, "%s: not a regular file (a device or pipe), not a scene file", path);
+        if (sb.st_size == 0) return mpm_error(MPM_EINPUT, "%s: empty file, not a scene file", path);
     }
     snprintf(out->path, sizeof out->path, "%s", path);
 

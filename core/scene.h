@@ -11,7 +11,20 @@
  *   "fps": 48,                        required, frames per second (> 0)
  *   "frames": 48,                     required, integer >= 1
  *   "cfl": 0.6,                       optional (default 0.6), > 0
- *   "max_dt": 0.0208333,              optional (default 1/fps), > 0
+ *   "max_dt": 0.0208333,              optional (default 1/fps), >= min_dt
+ *   "min_dt": 1e-6,                   optional (default 1e-6 s, the reference's
+ *                                     floor), <= 1/fps and >= 1/fps / 1e6: a
+ *                                     step whose CFL dt falls below it fails
+ *                                     (MPM_ENUMERIC) instead of silently
+ *                                     violating the CFL limit
+ *   "cfl_rule": "paper",              optional: which collider speed the CFL
+ *                                     dt sees (SPEC 12): "paper" (default)
+ *                                     the colliders' largest surface speed
+ *                                     over the particle bounding box grown
+ *                                     by 4 dx; "reference" also counts the
+ *                                     corners of each collider's own
+ *                                     bounding box as the HOT authors' code
+ *                                     does (collider_max_speed_reference)
  *   "gravity": [0, -9.8, 0],          required, m/s^2
  *   "apic_ratio": 1,                  optional (default 1): APIC/RPIC blend r in
  *                                     [0, 1]; 1 = APIC, 0 = RPIC
@@ -104,6 +117,8 @@
 #include "core/particles.h"
 #include "core/source.h"
 
+typedef enum { CFL_RULE_PAPER = 0, CFL_RULE_REFERENCE = 1 } CflRule;
+
 typedef struct {
     const char *key;
     const char *value;
@@ -122,10 +137,12 @@ typedef struct Scene {
     char path[1024];
     double dx;                        /* already multiplied by scale */
     int frames;
-    double fps, cfl, max_dt;          /* cfl default 0.6, max_dt default 1/fps */
+    double fps, cfl, max_dt, min_dt;  /* cfl default 0.6, max_dt default 1/fps, min_dt 1e-6 */
+    CflRule cfl_rule;                 /* collider speed rule of the CFL dt (SPEC 12) */
     double gravity[3];
     double apic_ratio;                /* RPIC/APIC blend r (1 = APIC, 0 = RPIC) */
     double domain_lo[3], domain_hi[3];
+    int domain_walls;                 /* the six wall colliders were added */
     Material *materials;              /* declaration order */
     int n_materials;
     Collider *colliders;              /* scene colliders, source colliders, then the domain walls */

@@ -536,6 +536,16 @@ void shape_bounds(const Shape *s, double lo[3], double hi[3])
     memcpy(hi, s->hi, 3 * sizeof(double));
 }
 
+void shape_reference_bounds(const Shape *s, double lo[3], double hi[3])
+{
+    if (s->type == SH_CYLINDER && !s->has_xf) {
+        double ext = sqrt(s->r * s->r + s->half_h * s->half_h);
+        for (int k = 0; k < 3; ++k) lo[k] = s->c[k] - ext, hi[k] = s->c[k] + ext;
+        return;
+    }
+    shape_bounds(s, lo, hi);
+}
+
 int shape_is_bounded(const Shape *s)
 {
     for (int k = 0; k < 3; ++k)

@@ -2,7 +2,9 @@
  *   step_begin: colliders at t^n, dt from CFL and frame boundaries, particle
  *               sort, sparse grid, P2G, Dirichlet nodes, the step problem;
  *   step_end:   v^{n+1} = v^n + dv, G2P (APIC/RPIC, F update, advection),
- *               plasticity (lagged), domain and finiteness checks. */
+ *               plasticity (lagged), sources; particles that crossed a
+ *               domain wall are held at its face; non-finite state or a
+ *               particle outside a wall-less domain is MPM_ENUMERIC. */
 #ifndef MPM_STEP_H
 #define MPM_STEP_H
 
@@ -28,9 +30,11 @@ typedef struct {
 int sim_init(Simulation *sim, const Scene *scene);
 void sim_free(Simulation *sim);
 
-/* dt rule of SPEC 2.1: cfl dx / vmax clamped to [1e-6, max_dt], then hitting
- * frame boundaries exactly. */
-double sim_next_dt(const Simulation *sim);
+/* dt rule of SPEC 2.1: cfl dx / vmax capped at max_dt, then hitting frame
+ * boundaries exactly. vmax counts the colliders by the scene's cfl_rule. A
+ * non-finite vmax, or a CFL dt below the scene's min_dt (which used to be
+ * raised to the floor silently, breaking the CFL limit), is MPM_ENUMERIC. */
+int sim_next_dt(const Simulation *sim, double *dt);
 
 int step_begin(Simulation *sim);
 /* dv is the solver's result over the step problem's nodes. */
