@@ -21,6 +21,8 @@
 #define MESH_WN_BETA 2.0
 #endif
 #define MESH_PI 3.14159265358979323846
+/* Largest accepted |vertex coordinate| [m]. */
+#define MESH_MAX_COORD 1e12
 
 typedef struct {
     double lo[3], hi[3];
@@ -198,8 +200,13 @@ static int parse_obj(const char *path, ObjData *d)
                                        line, token_text(s, tok));
                     goto done;
                 }
-                if (!isfinite(val)) {
-                    status = mpm_error(MPM_EINPUT, "%s:%d: non-finite vertex coordinate", path, line);
+                /* beyond MESH_MAX_COORD, sums (centroids) and cubes (volumes) of
+                 * coordinates overflow or lose every digit that matters */
+                if (!(fabs(val) <= MESH_MAX_COORD)) {
+                    char tok[32];
+                    status = mpm_error(MPM_EINPUT, "%s:%d: vertex coordinate '%s' is %s (expected |x| <= %g)", path,
+                                       line, token_text(s, tok), isfinite(val) ? "out of range" : "not finite",
+                                       MESH_MAX_COORD);
                     goto done;
                 }
                 if (k < 3) c[k] = val;
