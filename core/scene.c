@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "core/error.h"
 #include "core/mat3.h"
@@ -317,6 +318,7 @@ typedef struct {
     int F_per_particle;
     size_t surf_n;   /* surface particles (after --scale) */
     Shape *surf_mesh; /* "vertices_of": take (a subset of) its vertices; else surface samples */
+    double volume;    /* shape_volume once computed (the budget check may need it), else 0 */
 } ObjectSpec;
 
 /* "surface_particles": {"count": N} | {"vertices_of": mesh shape}. */
@@ -507,7 +509,74 @@ static int surface_points(const ObjectSpec *o, double dx, uint64_t seed, SampleP
     return st;
 }
 
-static int sample_objects(Scene *sc, const char *file, ObjectSpec *objs, int nobj)
+size_t scene_default_max_particles(void)
+{
+    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+    if (pages <= 0 || page <= 0) return 1000000; /* unknown memory: a laptop's worth */
+    double n = (double)pages * (double)page / 16384.0;
+    return n < 10000 ? 10000 : (size_t)n;
+}
+
+int scene_parse_particle_budget(const char *flag, const char *text, size_t *out)
+{
+    char *end = NULL;
+    double v = text && text[0] ? strtod(text, &end) : 0.0;
+    if (!end || *end || !(v >= 1 && v <= 1e12) || v != floor(v))
+        return mpm_error(MPM_EINPUT, "%s '%s': expected a whole number of particles in [1, 1e12]", flag,
+                         text ? text : "");
+    *out = (size_t)v;
+    return MPM_OK;
+}
+
+static size_t budget_of(const SceneLoadOptions *opt)
+{
+    return opt && opt->max_particles ? opt->max_particles : scene_default_max_particles();
+}
+
+static void dx_text(char *buf, size_t n, double dx, double scale)
+{
+    if (scale != 1.0)
+        snprintf(buf, n, "dx %g m (dx times --scale %g)", dx, scale);
+    else
+        snprintf(buf, n, "dx %g m", dx);
+}
+
+/* Before any sampling: the estimated particle count of every object, and
+ * of all of them, against the budget. */
+static int check_particle_budget(const Scene *sc, const char *file, ObjectSpec *objs, int nobj, double scale,
+                                 size_t budget)
+{
+    double total = 0.0, largest = 0.0;
+    int big = 0;
+    char dxs[96];
+    dx_text(dxs, sizeof dxs, sc->dx, scale);
+    for (int i = 0; i < nobj; ++i) {
+        ObjectSpec *o = &objs[i];
+        double density = o->sampling == SAMPLING_LATTICE ? 1.0 : SAMPLER_DENSITY;
+        double per_m3 = density * o->ppc / (sc->dx * sc->dx * sc->dx);
+        double vol = shape_volume_bound(o->shape);
+        double est = per_m3 * vol + (double)o->surf_n;
+        if (!(est <= (double)budget)) { /* the cheap bound is loose for CSG: ask the real volume */
+            o->volume = vol = shape_volume(o->shape);
+            est = per_m3 * vol + (double)o->surf_n;
+        }
+        if (!(est <= (double)budget))
+            return mpm_error(MPM_EINPUT,
+                             "%s: objects.%d: ppc %g at %s in a volume of %g m^3 gives about %.3g particles "
+                             "(%zu of them surface_particles), above the particle budget %zu (--max-particles)",
+                             file, i, o->ppc, dxs, vol, est, o->surf_n, budget);
+        total += est;
+        if (est > largest) largest = est, big = i;
+    }
+    if (!(total <= (double)budget))
+        return mpm_error(MPM_EINPUT,
+                         "%s: objects: %d objects at %s give about %.3g particles in total (the most: objects.%d, "
+                         "%.3g), above the particle budget %zu (--max-particles)",
+                         file, nobj, dxs, total, big, largest, budget);
+    return MPM_OK;
+}
+
+static int sample_objects(Scene *sc, const char *file, ObjectSpec *objs, int nobj, size_t budget)
 {
     PoissonTile *own = NULL;
     const PoissonTile *tile = NULL;
@@ -539,13 +608,21 @@ static int sample_objects(Scene *sc, const char *file, ObjectSpec *objs, int nob
             mpm_error_context(st, "%s: %s", file, path);
             break;
         }
+        if (sc->particles.n + pts.n > budget) { /* the estimate is an estimate: the real count decides */
+            st = mpm_error(MPM_EINPUT,
+                           "%s: %s: sampling reached %zu particles (ppc %g at dx %g m), above the particle budget %zu "
+                           "(--max-particles)",
+                           file, path, sc->particles.n + pts.n, o->ppc, sc->dx, budget);
+            sample_points_free(&pts);
+            break;
+        }
         if (pts.n == 0) {
             sample_points_free(&pts);
             st = mpm_error(MPM_EINPUT, "%s: %s: no particles sampled (shape smaller than the particle spacing at dx %g?)",
                            file, path, sc->dx);
             break;
         }
-        double vol = shape_volume(o->shape);
+        double vol = o->volume > 0 ? o->volume : shape_volume(o->shape);
         double vp = vol / (double)pts.n, mass = sc->materials[o->mat].density * vp;
         /* a node's mass can be 1e-30 of a particle's (a B-spline weight near a
          * stencil's edge): far smaller particle masses underflow to zero node
@@ -837,6 +914,7 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
         sj_path_index(p, sizeof p, "objects", i);
         st = parse_object(json_array_get(objs, i), file, p, (uint64_t)i, sc, asset_dir, scale, &spec[i]);
     }
+    if (!st) st = check_particle_budget(sc, file, spec, (int)nobj, scale, budget_of(opt));
 
     /* colliders */
     json_t *cols = json_object_get(root, "colliders");
@@ -866,7 +944,7 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
         if (!st && walls) st = add_walls(sc, file);
     }
 
-    if (!st) st = sample_objects(sc, file, spec, (int)nobj);
+    if (!st) st = sample_objects(sc, file, spec, (int)nobj, budget_of(opt));
     if (!st && sc->needs_plasticity) {
         int snow = 0;
         for (int k = 0; k < sc->n_materials; ++k)

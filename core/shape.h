@@ -78,6 +78,12 @@ void shape_reference_bounds(const Shape *s, double lo[3], double hi[3]);
 /* 1 if every side of the bounds is finite. */
 int shape_is_bounded(const Shape *s);
 
+/* A cheap upper bound of the volume (for budgets before sampling): exact for
+ * primitives and meshes, for CSG the sum (union), smallest (intersection)
+ * or first (difference) of the children's bounds, never above the bounding
+ * box's volume. HUGE_VAL when unbounded. */
+double shape_volume_bound(const Shape *s);
+
 /* Volume: exact for primitives (times scale^3), the mesh's enclosed volume
  * for meshes, and for CSG a deterministic adaptive-octree estimate (relative
  * error well below 1% for smooth shapes; see shape.c). HUGE_VAL when

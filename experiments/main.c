@@ -20,7 +20,7 @@ static void usage(FILE *f)
             "  mpmbench list solvers|scenes\n"
             "  mpmbench run --scene NAME|FILE --solver NAME [--frames N] [--eps E] [--scale S] [--threads T]\n"
             "               [--out DIR] [--set key=value ...] [--solver-opt key=value ...] [--history]\n"
-            "               [--particles DIR] [--asset-dir DIR] [--armijo] [--quiet]\n"
+            "               [--particles DIR] [--asset-dir DIR] [--armijo] [--quiet] [--max-particles N]\n"
             "  mpmbench bench spmv|assemble|p2g|all --scene NAME [--scale S] [--threads T] [--set key=value ...]\n"
             "  mpmbench render --scene NAME|FILE [--frame N] [--out FILE.png] [--solver NAME] [--scale S] [--set key=value ...]\n"
             "               [--view front|side|top|iso] [--color material|speed] [--width W] [--height H] [--asset-dir DIR] [--threads T]\n");
@@ -95,6 +95,9 @@ static int parse_args(int argc, char **argv, int first, Args *a)
         else if (!strcmp(f, "--threads")) {
             NEED_VAL();
             if ((st = threads_parse(f, val, &c->threads))) return st;
+        } else if (!strcmp(f, "--max-particles")) {
+            NEED_VAL();
+            if ((st = scene_parse_particle_budget(f, val, &c->max_particles))) return st;
         } else if (!strcmp(f, "--out")) { NEED_VAL(); c->out_dir = val; }
         else if (!strcmp(f, "--particles")) { NEED_VAL(); c->particles_dir = val; }
         else if (!strcmp(f, "--asset-dir")) { NEED_VAL(); c->asset_dir = val; }

@@ -26,6 +26,7 @@
 typedef struct {
     const char *scene, *solver, *out, *asset_dir;
     int frame, width, height, threads;
+    size_t max_particles;
     double scale;
     char view[8];
     int color_by;
@@ -81,7 +82,7 @@ static int parse_render_args(int argc, char **argv, RenderArgs *a)
             if (!strcmp(f, "--scene") || !strcmp(f, "--frame") || !strcmp(f, "--out") || !strcmp(f, "--solver") ||
                 !strcmp(f, "--scale") || !strcmp(f, "--set") || !strcmp(f, "--view") || !strcmp(f, "--color") ||
                 !strcmp(f, "--width") || !strcmp(f, "--height") || !strcmp(f, "--asset-dir") ||
-                !strcmp(f, "--threads"))
+                !strcmp(f, "--threads") || !strcmp(f, "--max-particles"))
                 return mpm_error(MPM_EINPUT, "%s: missing value", f);
             return mpm_error(MPM_EINPUT, "render: unknown option '%s' (see: mpmbench --help)", f);
         }
@@ -94,6 +95,7 @@ static int parse_render_args(int argc, char **argv, RenderArgs *a)
         else if (!strcmp(f, "--width")) { if ((st = rc_side(f, v, &a->width))) return st; }
         else if (!strcmp(f, "--height")) { if ((st = rc_side(f, v, &a->height))) return st; }
         else if (!strcmp(f, "--threads")) { if ((st = threads_parse(f, v, &a->threads))) return st; }
+        else if (!strcmp(f, "--max-particles")) { if ((st = scene_parse_particle_budget(f, v, &a->max_particles))) return st; }
         else if (!strcmp(f, "--scale")) { if ((st = rc_double(f, v, &a->scale))) return st; }
         else if (!strcmp(f, "--view")) {
             if (strcmp(v, "front") && strcmp(v, "side") && strcmp(v, "top") && strcmp(v, "iso"))
@@ -421,7 +423,8 @@ int render_command(int argc, char **argv)
     if (a.threads > 0) omp_set_num_threads(a.threads);
 
     Scene scene;
-    SceneLoadOptions lo = {a.scale, a.ov, a.n_ov, a.asset_dir};
+    SceneLoadOptions lo = {.scale = a.scale, .overrides = a.ov, .n_overrides = a.n_ov, .asset_dir = a.asset_dir,
+                           .max_particles = a.max_particles};
     if ((status = scene_load(a.scene, &lo, &scene))) return status;
     char path[1100];
     if (a.out) snprintf(path, sizeof path, "%s", a.out);

@@ -133,7 +133,8 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     int threads = omp_get_max_threads();
 
     Scene scene;
-    SceneLoadOptions lo = {cfg->scale, cfg->overrides, cfg->n_overrides, cfg->asset_dir};
+    SceneLoadOptions lo = {.scale = cfg->scale, .overrides = cfg->overrides, .n_overrides = cfg->n_overrides,
+                           .asset_dir = cfg->asset_dir, .max_particles = cfg->max_particles};
     if ((status = scene_load(cfg->scene, &lo, &scene))) return status;
     int frames = cfg->frames > 0 ? cfg->frames : scene.frames;
 

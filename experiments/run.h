@@ -24,6 +24,7 @@ typedef struct {
     const char *asset_dir;
     int armijo;
     int quiet;                  /* no per-frame table */
+    size_t max_particles;       /* particle budget (--max-particles); 0: scene_default_max_particles() */
 } RunConfig;
 
 typedef struct {

@@ -138,7 +138,7 @@ static void test_stretched_box(void)
     mpm_clear_error();
     /* scale 2 (dx 0.02) and the per-particle variant of the initial F */
     SceneOverride per = {"objects.0.initial_F.per_particle", "true"};
-    SceneLoadOptions lo = {2.0, &per, 1, NULL};
+    SceneLoadOptions lo = {.scale = 2.0, .overrides = &per, .n_overrides = 1};
     int st = scene_load("stretched-box", &lo, &s);
     CHECK(st == 0, "stretched-box: %s", mpm_last_error());
     if (st) return;

@@ -54,7 +54,7 @@ static int solve_first_step(const char *scene_name, const SceneOverride *ov, int
                             const char *solver, Outcome *out)
 {
     Scene sc;
-    SceneLoadOptions lo = {scale, ov, n_ov, NULL};
+    SceneLoadOptions lo = {.scale = scale, .overrides = ov, .n_overrides = n_ov};
     if (scene_load(scene_name, &lo, &sc)) return 1;
     Simulation sim;
     sim_init(&sim, &sc);
@@ -86,7 +86,7 @@ static double energy_norm_check(const char *scene, const SceneOverride *ov, int 
                                 Outcome *res, int np, double *diff, double *gnorm)
 {
     Scene sc;
-    SceneLoadOptions lo = {scale, ov, n_ov, NULL};
+    SceneLoadOptions lo = {.scale = scale, .overrides = ov, .n_overrides = n_ov};
     if (scene_load(scene, &lo, &sc)) return 0;
     Simulation sim;
     sim_init(&sim, &sc);
