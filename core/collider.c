@@ -129,6 +129,8 @@ double collider_max_speed(const Collider *c, double t, const double lo[3], const
     const ColliderPhase *ph = &c->phases[find_phase(c, t)];
     if (ph->removed) return 0.0;
     if (c->cfl_speed >= 0.0) return c->cfl_speed;
+    for (int k = 0; k < 3; ++k)
+        if (!(lo[k] <= hi[k])) return 0.0; /* an empty box (no particles yet): no material there */
     /* Current world bounds of the collider: the rest bounds' corners posed. */
     double slo[3], shi[3], blo[3], bhi[3];
     shape_bounds(c->shape, slo, shi);
@@ -169,7 +171,8 @@ double collider_max_speed(const Collider *c, double t, const double lo[3], const
         for (int k = 0; k < 3; ++k) x[k] = (corner >> k) & 1 ? box_hi[k] : box_lo[k];
         velocity_in_phase(c, ph, t, x, v);
         double s = v3_norm(v);
-        if (!(s <= vmax)) vmax = s; /* NaN propagates: the caller refuses it */
+        if (s > vmax || isnan(s)) vmax = s; /* NaN propagates: the caller refuses it */
+        if (isnan(vmax)) break;
     }
     return vmax;
 }
@@ -187,7 +190,7 @@ double collider_max_speed_reference(const Collider *c, double t, const double lo
     if (ph->removed) return 0.0;
     if (c->cfl_speed >= 0.0) return c->cfl_speed;
     double vmax = collider_max_speed(c, t, lo, hi);
-    if (!shape_is_bounded(c->shape)) return vmax;
+    if (!shape_is_bounded(c->shape) || isnan(vmax)) return vmax;
     double slo[3], shi[3], R[9], b[3];
     shape_reference_bounds(c->shape, slo, shi);
     full_pose(c, ph, t, R, b);
@@ -204,7 +207,8 @@ double collider_max_speed_reference(const Collider *c, double t, const double lo
         if (!any) continue;
         velocity_in_phase(c, ph, t, x, v);
         double sp = v3_norm(v);
-        if (!(sp <= vmax)) vmax = sp; /* NaN propagates: the caller refuses it */
+        if (sp > vmax || isnan(sp)) vmax = sp; /* NaN propagates: the caller refuses it */
+        if (isnan(vmax)) break;
     }
     return vmax;
 }

@@ -65,7 +65,7 @@ int sim_next_dt(const Simulation *sim, double *dt_out)
     for (size_t k = 0; k < p->n; ++k) {
         const double *v = p->v + 3 * k, *x = p->x + 3 * k;
         double s = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-        if (!(s <= vmax)) vmax = s, fastest = k; /* a NaN speed is kept, and refused below */
+        if (s > vmax || isnan(s)) vmax = s, fastest = k; /* a NaN is kept (s > NaN is false) and refused below */
         for (int d = 0; d < 3; ++d) {
             if (x[d] < lo[d]) lo[d] = x[d];
             if (x[d] > hi[d]) hi[d] = x[d];
@@ -84,7 +84,7 @@ int sim_next_dt(const Simulation *sim, double *dt_out)
         if (!collider_active(col, sim->t)) continue;
         double s = sc->cfl_rule == CFL_RULE_REFERENCE ? collider_max_speed_reference(col, sim->t, lo, hi)
                                                       : collider_max_speed(col, sim->t, lo, hi);
-        if (!(s <= vmax)) vmax = s, who = "collider", collider = c;
+        if (s > vmax || isnan(s)) vmax = s, who = "collider", collider = c;
     }
     char name[96];
     if (collider >= 0)
