@@ -1,0 +1,29 @@
+#include "tests/fuzz/harness.h"
+
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+const char *fuzz_write_input(const uint8_t *data, size_t size, const char *suffix)
+{
+    static char path[256];
+    struct stat st;
+    const char *dir = stat("/dev/shm", &st) == 0 && S_ISDIR(st.st_mode) ? "/dev/shm" : "/tmp";
+    snprintf(path, sizeof path, "%s/mpm_fuzz_%d%s", dir, (int)getpid(), suffix);
+    FILE *f = fopen(path, "wb");
+    if (!f) return NULL;
+    size_t w = size ? fwrite(data, 1, size, f) : 0;
+    if (fclose(f) != 0 || w != size) return NULL;
+    return path;
+}
+
+void fuzz_setup(void)
+{
+    omp_set_num_threads(1);
+#ifdef MPM_SCENE_DIR
+    setenv("MPM_SCENE_DIR", MPM_SCENE_DIR, 0);
+#endif
+}

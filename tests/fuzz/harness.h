@@ -1,0 +1,18 @@
+/* Shared by the libFuzzer harnesses (tests/fuzz/fuzz_*.c): the loaders read
+ * files, so each input is written to one scratch file per process, in
+ * tmpfs when there is one. */
+#ifndef MPM_FUZZ_HARNESS_H
+#define MPM_FUZZ_HARNESS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* Writes data to a scratch file named after `suffix` (e.g. ".json") and
+ * returns its path (static storage), NULL on an I/O error. */
+const char *fuzz_write_input(const uint8_t *data, size_t size, const char *suffix);
+
+/* Environment every harness wants: one OpenMP thread (fast, deterministic
+ * inputs) and the built-in scene directory. Call from LLVMFuzzerInitialize. */
+void fuzz_setup(void);
+
+#endif
