@@ -219,10 +219,10 @@ static int check_state(const Simulation *sim)
                          "t = %.9g s: particle %zu became non-finite (x = (%g, %g, %g), v = (%g, %g, %g), F00 = %g)",
                          sim->t, bad, x[0], x[1], x[2], v[0], v[1], v[2], F[0]);
     return mpm_error(MPM_ENUMERIC,
-                     "t = %.9g s: particle %zu at (%g, %g, %g) left the domain [%g, %g, %g]-[%g, %g, %g] "
-                     "(no domain_walls)",
+                     "t = %.9g s: particle %zu at (%g, %g, %g) left the domain [%g, %g, %g]-[%g, %g, %g]%s",
                      sim->t, bad, x[0], x[1], x[2], sc->domain_lo[0], sc->domain_lo[1], sc->domain_lo[2],
-                     sc->domain_hi[0], sc->domain_hi[1], sc->domain_hi[2]);
+                     sc->domain_hi[0], sc->domain_hi[1], sc->domain_hi[2],
+                     sc->domain_walls ? "" : " (no domain_walls)");
 }
 
 int step_end(Simulation *sim, const double *dv)
