@@ -11,9 +11,6 @@
 #include "core/mesh.h"
 #include "tests/fuzz/harness.h"
 
-int LLVMFuzzerInitialize(int *argc, char ***argv);
-int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
-
 int LLVMFuzzerInitialize(int *argc, char ***argv)
 {
     (void)argc;
@@ -30,11 +27,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     Mesh *m = NULL;
     mpm_clear_error();
     int st = size && data[0] == '#' ? mesh_load_obj_lenient(path, 8, &m) : mesh_load_obj(path, &m);
-    const char *msg = mpm_last_error();
-    if (st != MPM_OK && (msg[0] == '\0' || strchr(msg, '\n'))) {
-        fprintf(stderr, "mesh_load_obj status %d without a one-line message: '%s'\n", st, msg);
-        abort();
-    }
+    fuzz_require_message(st, "mesh_load_obj");
     if (st == MPM_OK) {
         double v = mesh_volume(m);
         if (!(v > 0) || !isfinite(v)) {

@@ -14,9 +14,6 @@
 #include "core/scene.h"
 #include "tests/fuzz/harness.h"
 
-int LLVMFuzzerInitialize(int *argc, char ***argv);
-int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
-
 int LLVMFuzzerInitialize(int *argc, char ***argv)
 {
     (void)argc;
@@ -35,11 +32,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     SceneLoadOptions opt = {.max_particles = 20000};
     mpm_clear_error();
     int st = scene_load(path, &opt, &s);
-    const char *msg = mpm_last_error();
-    if (st != MPM_OK && (msg[0] == '\0' || strchr(msg, '\n'))) {
-        fprintf(stderr, "scene_load status %d without a one-line message: '%s'\n", st, msg);
-        abort();
-    }
+    fuzz_require_message(st, "scene_load");
     if (st == MPM_OK) {
         for (size_t k = 0; k < 3 * s.particles.n; ++k)
             if (!(s.particles.x[k] >= s.domain_lo[k % 3] && s.particles.x[k] <= s.domain_hi[k % 3])) {

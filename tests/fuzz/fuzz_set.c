@@ -12,9 +12,6 @@
 #include "core/scene.h"
 #include "tests/fuzz/harness.h"
 
-int LLVMFuzzerInitialize(int *argc, char ***argv);
-int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
-
 static char g_scene[256];
 
 static const char k_base[] =
@@ -70,11 +67,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     SceneLoadOptions opt = {.overrides = ov, .n_overrides = n, .max_particles = 20000};
     mpm_clear_error();
     int st = scene_load(g_scene, &opt, &s);
-    const char *msg = mpm_last_error();
-    if (st != MPM_OK && (msg[0] == '\0' || strchr(msg, '\n'))) {
-        fprintf(stderr, "scene_load with --set: status %d without a one-line message: '%s'\n", st, msg);
-        abort();
-    }
+    fuzz_require_message(st, "scene_load with --set");
     if (st == MPM_OK) scene_free(&s);
     free(text);
     return 0;

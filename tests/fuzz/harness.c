@@ -1,5 +1,7 @@
 #include "tests/fuzz/harness.h"
 
+#include "core/error.h"
+
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,4 +28,13 @@ void fuzz_setup(void)
 #ifdef MPM_SCENE_DIR
     setenv("MPM_SCENE_DIR", MPM_SCENE_DIR, 0);
 #endif
+}
+
+void fuzz_require_message(int status, const char *what)
+{
+    if (status == MPM_OK) return;
+    const char *msg = mpm_last_error();
+    if (msg[0] && !strchr(msg, '\n')) return;
+    fprintf(stderr, "%s: status %d without a one-line message: '%s'\n", what, status, msg);
+    abort();
 }

@@ -11,6 +11,14 @@
  * returns its path (static storage), NULL on an I/O error. */
 const char *fuzz_write_input(const uint8_t *data, size_t size, const char *suffix);
 
+/* The libFuzzer entry points every harness defines. */
+int LLVMFuzzerInitialize(int *argc, char ***argv);
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+/* The error contract on every input: a failing status comes with a
+ * recorded one-line message (else abort(), which the fuzzer reports). */
+void fuzz_require_message(int status, const char *what);
+
 /* Environment every harness wants: one OpenMP thread (fast, deterministic
  * inputs) and the built-in scene directory. Call from LLVMFuzzerInitialize. */
 void fuzz_setup(void);
