@@ -48,7 +48,7 @@ for t in "${targets[@]}"; do
     -artifact_prefix="$crashes/" -print_final_stats=1 >"$log" 2>&1
   rc=$?
   set -e
-  execs=$(grep -E "^stat::number_of_executed_units" "$log" | awk '{print $2}')
+  execs=$(grep -E "^stat::number_of_executed_units" "$log" | tail -1 | awk '{print $2}')
   ncrash=$(find "$crashes" -type f | wc -l)
   echo "fuzz $t: ${execs:-0} executions in $seconds s, exit $rc, $ncrash crash/leak/timeout inputs in $crashes (log $log)"
   if [ "$rc" -ne 0 ]; then
