@@ -57,6 +57,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         char *eq = strchr(line, '=');
         if (eq) { /* like main.c: key=value, the key non-empty */
             *eq = '\0';
+            if (strcmp(line, "seed") == 0 && fuzz_new_tile_seed((const uint8_t *)eq + 1, strlen(eq + 1))) {
+                line = nl ? nl + 1 : NULL; /* a new Poisson tile: seconds, see fuzz_scene.c */
+                continue;
+            }
             ov[n].key = line;
             ov[n].value = eq + 1;
             ++n;

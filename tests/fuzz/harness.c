@@ -2,6 +2,7 @@
 
 #include "core/error.h"
 
+#include <jansson.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -37,4 +38,15 @@ void fuzz_require_message(int status, const char *what)
     if (msg[0] && !strchr(msg, '\n')) return;
     fprintf(stderr, "%s: status %d without a one-line message: '%s'\n", what, status, msg);
     abort();
+}
+
+int fuzz_new_tile_seed(const uint8_t *json, size_t size)
+{
+    json_error_t err;
+    json_t *v = json_loadb((const char *)json, size, JSON_DECODE_ANY, &err);
+    if (!v) return 0;
+    json_t *seed = json_is_object(v) ? json_object_get(v, "seed") : v;
+    int skip = json_is_integer(seed) && json_integer_value(seed) >= 0 && json_integer_value(seed) != 1;
+    json_decref(v);
+    return skip;
 }

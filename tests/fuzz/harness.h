@@ -19,6 +19,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
  * recorded one-line message (else abort(), which the fuzzer reports). */
 void fuzz_require_message(int status, const char *what);
 
+/* 1 if the JSON text (a whole scene, or a bare value) sets a valid
+ * Poisson-tile seed other than 1, whose tile would take seconds to make. */
+int fuzz_new_tile_seed(const uint8_t *json, size_t size);
+
 /* Environment every harness wants: one OpenMP thread (fast, deterministic
  * inputs) and the built-in scene directory. Call from LLVMFuzzerInitialize. */
 void fuzz_setup(void);
