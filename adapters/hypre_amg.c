@@ -106,7 +106,19 @@ typedef struct {
     int n;
 } Amg;
 
-static int g_hypre_ready = 0;
+static int g_hypre_ready = 0, g_mpi_ours = 0;
+
+/* At exit: hypre's and (when this adapter started it) MPI's global state is
+ * released, so leak checkers see a clean process. */
+static void hypre_global_finalize(void)
+{
+    if (!g_hypre_ready) return;
+    HYPRE_Finalize();
+    int finalized = 0;
+    MPI_Finalized(&finalized);
+    if (g_mpi_ours && !finalized) MPI_Finalize();
+    g_hypre_ready = 0;
+}
 
 /* MPI and hypre library initialisation, once per process (header: "MPI"). */
 static int hypre_global_init(void)
@@ -116,13 +128,16 @@ static int hypre_global_init(void)
     MPI_Initialized(&inited);
     MPI_Finalized(&finalized);
     if (finalized) return mpm_error(MPM_EINTERNAL, "boomeramg: MPI has already been finalised");
-    if (!inited && MPI_Init(NULL, NULL) != MPI_SUCCESS)
-        return mpm_error(MPM_EINTERNAL, "boomeramg: MPI_Init failed");
+    if (!inited) {
+        if (MPI_Init(NULL, NULL) != MPI_SUCCESS) return mpm_error(MPM_EINTERNAL, "boomeramg: MPI_Init failed");
+        g_mpi_ours = 1;
+    }
     if (HYPRE_Init() != 0) {
         HYPRE_ClearAllErrors();
         return mpm_error(MPM_EINTERNAL, "boomeramg: HYPRE_Init failed");
     }
     g_hypre_ready = 1;
+    atexit(hypre_global_finalize);
     return MPM_OK;
 }
 

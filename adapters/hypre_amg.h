@@ -38,9 +38,10 @@
  *
  * MPI: hypre needs MPI. The adapter calls MPI_Init(NULL, NULL) the first time
  * it is set up if the program has not initialised MPI, and HYPRE_Init() once.
- * It never calls MPI_Finalize or HYPRE_Finalize (a program that wants a clean
- * MPI shutdown calls MPI_Finalize itself after destroying every solver). A
- * program that uses MPI itself must call MPI_Init before the first setup.
+ * At exit (atexit) it calls HYPRE_Finalize, and MPI_Finalize when it was the
+ * one that initialised MPI, so leak checkers (ASan, valgrind) see a clean
+ * process. A program that uses MPI itself must call MPI_Init before the
+ * first setup and finalises MPI itself.
  * Every solve is local to the calling process: hypre runs on MPI_COMM_SELF,
  * so ranks of a distributed experiment matrix never share a hypre matrix. */
 #ifndef MPM_HYPRE_AMG_H

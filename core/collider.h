@@ -128,7 +128,7 @@ int collider_active(const Collider *c, double t);
  * rigid speed |omega x r + v| is convex in x, so its maximum over a box is at
  * a corner. The box used is [lo, hi] intersected with the collider's current
  * world bounds when they overlap, else [lo, hi] itself. 0 when inactive;
- * "cfl_speed" when the collider has one. */
+ * "cfl_speed" when the collider has one. A NaN speed is returned as NaN. */
 double collider_max_speed(const Collider *c, double t, const double lo[3], const double hi[3]);
 
 /* Coulomb friction at one grid node, applied to the grid velocity v^{n+1}
@@ -148,6 +148,11 @@ double collider_max_speed(const Collider *c, double t, const double lo[3], const
  * place. Returns 0 (untouched), 1 (tangential speed reduced) or 2 (stuck).
  * The relative kinetic energy 1/2 |v_rel|^2 never increases. */
 int collider_friction(const double normal[3], const double v_col[3], double mu, double jn, double v[3]);
+
+/* The reference's variant of collider_max_speed (scene "cfl_rule":
+ * "reference", SPEC 12): also the speeds at the corners of the collider's
+ * own bounding box that pass the reference's any-axis overlap test. */
+double collider_max_speed_reference(const Collider *c, double t, const double lo[3], const double hi[3]);
 
 void collider_free(Collider *c);
 

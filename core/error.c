@@ -1,29 +1,106 @@
 #include "core/error.h"
 
+#include <omp.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <string.h>
 
-static char g_message[1024];
-static int g_has_message;
+enum { MESSAGE_CAP = 1024 };
+
+typedef struct {
+    char text[MESSAGE_CAP];
+    int set;
+} Message;
+
+/* Each thread's own message; worker threads of a parallel region write the
+ * shared one under a lock (see error.h). */
+static _Thread_local Message t_own;
+static Message g_team;
+
+static int in_worker(void) { return omp_in_parallel() && omp_get_thread_num() != 0; }
+
+static void record(Message *m, const char *fmt, va_list ap)
+{
+    if (m->set) return; /* the first message of a failure is the most precise one */
+    vsnprintf(m->text, sizeof m->text, fmt, ap);
+    m->set = 1;
+}
 
 int mpm_error(int status, const char *fmt, ...)
 {
-    /* The first message of a failure is the most precise one; callers up the
-     * stack only propagate the status. */
-    if (!g_has_message) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(g_message, sizeof g_message, fmt, ap);
-        va_end(ap);
-        g_has_message = 1;
+    va_list ap;
+    va_start(ap, fmt);
+    if (in_worker()) {
+#pragma omp critical(mpm_error_team)
+        record(&g_team, fmt, ap);
+    } else {
+        record(&t_own, fmt, ap);
     }
+    va_end(ap);
     return status;
 }
 
-const char *mpm_last_error(void) { return g_has_message ? g_message : ""; }
+/* The worker slot's message moves into the caller's own slot, so context
+ * added after a parallel region prefixes it. */
+static void adopt_team_message(void)
+{
+    if (t_own.set) return;
+#pragma omp critical(mpm_error_team)
+    {
+        if (g_team.set) {
+            memcpy(t_own.text, g_team.text, sizeof t_own.text);
+            t_own.set = 1;
+            g_team.set = 0;
+            g_team.text[0] = '\0';
+        }
+    }
+}
+
+/* m = "<ctx>: <m>" (or ctx alone when m is empty), truncated to the buffer. */
+static void prefix(Message *m, const char *ctx)
+{
+    char out[MESSAGE_CAP];
+    size_t n = 0, cap = sizeof out - 1;
+    const char *parts[3] = {ctx, m->set ? ": " : "", m->set ? m->text : ""};
+    for (int k = 0; k < 3; ++k)
+        for (const char *c = parts[k]; *c && n < cap; ++c) out[n++] = *c;
+    out[n] = '\0';
+    memcpy(m->text, out, n + 1);
+    m->set = 1;
+}
+
+int mpm_error_context(int status, const char *fmt, ...)
+{
+    if (status == MPM_OK) return status;
+    char ctx[MESSAGE_CAP];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(ctx, sizeof ctx, fmt, ap);
+    va_end(ap);
+    if (in_worker()) {
+#pragma omp critical(mpm_error_team)
+        prefix(&g_team, ctx);
+        return status;
+    }
+    adopt_team_message();
+    prefix(&t_own, ctx);
+    return status;
+}
+
+const char *mpm_last_error(void)
+{
+    if (!in_worker()) adopt_team_message();
+    return t_own.set ? t_own.text : "";
+}
 
 void mpm_clear_error(void)
 {
-    g_has_message = 0;
-    g_message[0] = '\0';
+    t_own.set = 0;
+    t_own.text[0] = '\0';
+    if (in_worker()) return;
+#pragma omp critical(mpm_error_team)
+    {
+        g_team.set = 0;
+        g_team.text[0] = '\0';
+    }
 }

@@ -21,6 +21,8 @@
 #define MESH_WN_BETA 2.0
 #endif
 #define MESH_PI 3.14159265358979323846
+/* Largest accepted |vertex coordinate| [m]. */
+#define MESH_MAX_COORD 1e12
 
 typedef struct {
     double lo[3], hi[3];
@@ -198,8 +200,13 @@ static int parse_obj(const char *path, ObjData *d)
                                        line, token_text(s, tok));
                     goto done;
                 }
-                if (!isfinite(val)) {
-                    status = mpm_error(MPM_EINPUT, "%s:%d: non-finite vertex coordinate", path, line);
+                /* beyond MESH_MAX_COORD, sums (centroids) and cubes (volumes) of
+                 * coordinates overflow or lose every digit that matters */
+                if (!(fabs(val) <= MESH_MAX_COORD)) {
+                    char tok[32];
+                    status = mpm_error(MPM_EINPUT, "%s:%d: vertex coordinate '%s' is %s (expected |x| <= %g)", path,
+                                       line, token_text(s, tok), isfinite(val) ? "out of range" : "not finite",
+                                       MESH_MAX_COORD);
                     goto done;
                 }
                 if (k < 3) c[k] = val;
@@ -421,18 +428,29 @@ static double half_area(const double lo[3], const double hi[3])
     return e0 * e1 + e1 * e2 + e2 * e0;
 }
 
+enum { NB = 16 }; /* SAH bins per axis */
+
+/* The bin of centroid coordinate c in [lo, lo + ext], ext > 0. The ratio is
+ * formed first: NB / ext overflows for a subnormal extent (a fuzzed mesh
+ * with coordinates like 0x9p-1074), and 0 * inf is NaN, whose int cast is
+ * undefined. */
+static int centroid_bin(double c, double lo, double ext)
+{
+    double f = (c - lo) / ext * NB;
+    if (!(f >= 0)) return 0;
+    return f >= NB ? NB - 1 : (int)f;
+}
+
 /* Binned surface-area-heuristic split of perm[start, end): partitions the
  * range and returns the split position, or -1 when every centroid falls in
  * one bin. */
 static int sah_split(Builder *b, int start, int end, const double clo[3], const double chi[3])
 {
-    enum { NB = 16 };
     double best_cost = INFINITY;
     int best_axis = -1, best_bin = -1;
     for (int axis = 0; axis < 3; ++axis) {
         double ext = chi[axis] - clo[axis];
         if (!(ext > 0)) continue;
-        double scale = NB / ext;
         int cnt[NB] = {0};
         double blo[NB][3], bhi[NB][3];
         for (int k = 0; k < NB; ++k)
@@ -442,9 +460,7 @@ static int sah_split(Builder *b, int start, int end, const double clo[3], const 
             }
         for (int k = start; k < end; ++k) {
             int t = b->perm[k];
-            int bin = (int)((b->cent[3 * t + axis] - clo[axis]) * scale);
-            if (bin >= NB) bin = NB - 1;
-            if (bin < 0) bin = 0;
+            int bin = centroid_bin(b->cent[3 * t + axis], clo[axis], ext);
             ++cnt[bin];
             const double *tb = b->tbox + 6 * t;
             for (int d = 0; d < 3; ++d) {
@@ -485,12 +501,11 @@ static int sah_split(Builder *b, int start, int end, const double clo[3], const 
         }
     }
     if (best_axis < 0) return -1;
-    double scale = NB / (chi[best_axis] - clo[best_axis]);
+    double best_ext = chi[best_axis] - clo[best_axis];
     int i = start, j = end - 1;
     while (i <= j) {
         int t = b->perm[i];
-        int bin = (int)((b->cent[3 * t + best_axis] - clo[best_axis]) * scale);
-        if (bin >= NB) bin = NB - 1;
+        int bin = centroid_bin(b->cent[3 * t + best_axis], clo[best_axis], best_ext);
         if (bin <= best_bin) {
             ++i;
         } else {

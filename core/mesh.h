@@ -23,7 +23,8 @@ typedef struct Mesh Mesh;
  * vertices are fan-triangulated; indices i, i/t, i/t/n, i//n, negative
  * relative indices); vt, vn, o, g, s, usemtl, mtllib, l, p and comments are
  * ignored. Fails with MPM_EINPUT and a message naming the file (and line)
- * for a missing file, a malformed line, an index out of range, a face with
+ * for a missing file, a malformed line, a vertex coordinate that is not
+ * finite or above 1e12 in magnitude (the value is quoted), an index out of range, a face with
  * fewer than 3 vertices, no faces, no enclosed volume, or a surface that is
  * not closed: boundary edges (edges used by an odd number of faces, e.g. by
  * exactly one) or edges between inconsistently oriented faces. Vertices at

@@ -60,6 +60,8 @@ int particles_copy(Particles *dst, const Particles *src)
     if (st) return st;
     if (src->Jp && (st = particles_enable_plastic_state(dst))) return st;
     size_t n = src->n;
+    dst->n = n;
+    if (n == 0) return MPM_OK; /* a scene that starts empty (sources only): no arrays yet */
     memcpy(dst->x, src->x, sizeof(double) * 3 * n);
     memcpy(dst->v, src->v, sizeof(double) * 3 * n);
     memcpy(dst->C, src->C, sizeof(double) * 9 * n);
@@ -69,7 +71,6 @@ int particles_copy(Particles *dst, const Particles *src)
     memcpy(dst->mat, src->mat, sizeof(int) * n);
     if (src->Jp) memcpy(dst->Jp, src->Jp, sizeof(double) * n);
     memcpy(dst->id, src->id, sizeof(size_t) * n);
-    dst->n = n;
     return MPM_OK;
 }
 
@@ -91,6 +92,7 @@ static void permute_field(double *f, size_t width, size_t n, const size_t *perm,
 void particles_permute(Particles *p, const size_t *perm, double *scratch)
 {
     size_t n = p->n;
+    if (n == 0) return;
     permute_field(p->x, 3, n, perm, scratch);
     permute_field(p->v, 3, n, perm, scratch);
     permute_field(p->C, 9, n, perm, scratch);

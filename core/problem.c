@@ -1,31 +1,27 @@
 #include "core/problem.h"
 
 #include <math.h>
-#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
 #include "core/fcr.h"
 #include "core/mat3.h"
+#include "core/reduce.h"
 
-#define MAX_THREADS 256
 #define NEIGH 125
 
-/* Offset index of node (i + d), d in [-2,2]^3, in a row's 125 slots. */
-static inline int neigh_index(int dx, int dy, int dz) { return 25 * (dx + 2) + 5 * (dy + 2) + (dz + 2); }
-
-/* Offset index between stencil slots s and t of one particle. */
-static int g_pair_offset[27][27];
-static void init_pair_offsets(void)
-{
-    static int done = 0;
-    if (done) return;
-    for (int s = 0; s < 27; ++s)
-        for (int t = 0; t < 27; ++t)
-            g_pair_offset[s][t] = neigh_index(t / 9 - s / 9, (t / 3) % 3 - (s / 3) % 3, t % 3 - s % 3);
-    done = 1;
-}
+/* Offset index between stencil slots s and t of one particle: node (i + d),
+ * d = (t/9 - s/9, (t/3)%3 - (s/3)%3, t%3 - s%3) in [-2,2]^3, has slot
+ * 25 (d0 + 2) + 5 (d1 + 2) + (d2 + 2) of a row's 125. Generated at compile
+ * time: constant data, nothing to build or synchronise at run time. */
+#define PAIR_OFFSET(s, t) (25 * ((t) / 9 - (s) / 9 + 2) + 5 * ((t) / 3 % 3 - (s) / 3 % 3 + 2) + ((t) % 3 - (s) % 3 + 2))
+#define PAIR_ROW3(s, t) PAIR_OFFSET(s, t), PAIR_OFFSET(s, (t) + 1), PAIR_OFFSET(s, (t) + 2)
+#define PAIR_ROW9(s, t) PAIR_ROW3(s, t), PAIR_ROW3(s, (t) + 3), PAIR_ROW3(s, (t) + 6)
+#define PAIR_ROW(s) {PAIR_ROW9(s, 0), PAIR_ROW9(s, 9), PAIR_ROW9(s, 18)}
+#define PAIR_ROWS3(s) PAIR_ROW(s), PAIR_ROW((s) + 1), PAIR_ROW((s) + 2)
+#define PAIR_ROWS9(s) PAIR_ROWS3(s), PAIR_ROWS3((s) + 3), PAIR_ROWS3((s) + 6)
+static const unsigned char g_pair_offset[27][27] = {PAIR_ROWS9(0), PAIR_ROWS9(9), PAIR_ROWS9(18)};
 
 static int grow(void **ptr, size_t bytes)
 {
@@ -68,7 +64,6 @@ static int ensure_capacity(StepProblem *pb, size_t np, int nn)
 int problem_prepare(StepProblem *pb, const Grid *g, const Stencils *st, const Particles *p,
                     const Material *mats, int n_mats, double dt, const double gravity[3])
 {
-    init_pair_offsets();
     int status = ensure_capacity(pb, p->n, g->n);
     if (status) return status;
     pb->n_nodes = g->n;
@@ -103,6 +98,7 @@ int problem_prepare(StepProblem *pb, const Grid *g, const Stencils *st, const Pa
         }
     }
     pb->max_stiffness = maxstiff;
+    if (g->n == 0) return MPM_OK; /* no particles yet (a scene of sources only): nothing to set up */
 
     /* CN scale: kappa_i = 24 dx^2 dt abar_i, abar_i = sum_p w_ip m_p a_p / m_i
      * (SPEC 4, HOT §5.2). Scatter by particle-block colour. */
@@ -173,7 +169,7 @@ void problem_set_dirichlet(StepProblem *pb, int i, const double v_target[3], con
 
 void problem_initial_guess(const StepProblem *pb, double *dv)
 {
-    memcpy(dv, pb->dv0, sizeof(double) * 3 * (size_t)pb->n_nodes);
+    if (pb->n_nodes > 0) memcpy(dv, pb->dv0, sizeof(double) * 3 * (size_t)pb->n_nodes);
 }
 
 static inline void project_node(const StepProblem *pb, int i, double *v)
@@ -194,68 +190,63 @@ void problem_project(const StepProblem *pb, double *v)
     for (int i = 0; i < pb->n_nodes; ++i) project_node(pb, i, v + 3 * (size_t)i);
 }
 
-/* Sum of per-thread partials in thread order: deterministic for a fixed
- * thread count. */
+/* The energy's sums go through reduce_sum (core/reduce.h): the same bits for
+ * every thread count. */
 typedef struct {
-    double v[MAX_THREADS];
-    int nt;
-} Partials;
+    StepProblem *pb;
+    const double *dv;
+} EnergyArgs;
 
-double problem_energy(StepProblem *pb, const double *dv)
+/* Elastic energy of particles [begin, end); stores F(dv) and P(F) per particle. */
+static double elastic_range(const void *ctx, size_t begin, size_t end)
 {
+    const EnergyArgs *ea = ctx;
+    StepProblem *pb = ea->pb;
+    const double *dv = ea->dv;
     const Particles *p = pb->parts;
     const Stencils *st = pb->st;
     const double *vn = pb->grid->v;
-    double dt = pb->dt;
-    Partials part = {{0}, 1};
-#pragma omp parallel
-    {
-        int t = omp_get_thread_num();
-#pragma omp single
-        part.nt = omp_get_num_threads();
-        double e = 0.0;
-#pragma omp for schedule(static)
-        for (size_t k = 0; k < p->n; ++k) {
-            const int *node = st->node + 27 * k;
-            const double *a = pb->a + 81 * k;
-            double *F = pb->F + 9 * k;
-            m3_copy(F, p->F + 9 * k);
-            for (int s = 0; s < 27; ++s) {
-                int i = node[s];
-                if (i < 0) continue;
-                double u0 = dt * (vn[3 * i] + dv[3 * i]), u1 = dt * (vn[3 * i + 1] + dv[3 * i + 1]),
-                       u2 = dt * (vn[3 * i + 2] + dv[3 * i + 2]);
-                const double *as = a + 3 * s;
-                F[0] += u0 * as[0]; F[1] += u0 * as[1]; F[2] += u0 * as[2];
-                F[3] += u1 * as[0]; F[4] += u1 * as[1]; F[5] += u1 * as[2];
-                F[6] += u2 * as[0]; F[7] += u2 * as[1]; F[8] += u2 * as[2];
-            }
-            e += p->vol[k] * fcr_psi_P(F, pb->mu[k], pb->lambda[k], pb->P + 9 * k);
+    double dt = pb->dt, e = 0.0;
+    for (size_t k = begin; k < end; ++k) {
+        const int *node = st->node + 27 * k;
+        const double *a = pb->a + 81 * k;
+        double *F = pb->F + 9 * k;
+        m3_copy(F, p->F + 9 * k);
+        for (int s = 0; s < 27; ++s) {
+            int i = node[s];
+            if (i < 0) continue;
+            double u0 = dt * (vn[3 * i] + dv[3 * i]), u1 = dt * (vn[3 * i + 1] + dv[3 * i + 1]),
+                   u2 = dt * (vn[3 * i + 2] + dv[3 * i + 2]);
+            const double *as = a + 3 * s;
+            F[0] += u0 * as[0]; F[1] += u0 * as[1]; F[2] += u0 * as[2];
+            F[3] += u1 * as[0]; F[4] += u1 * as[1]; F[5] += u1 * as[2];
+            F[6] += u2 * as[0]; F[7] += u2 * as[1]; F[8] += u2 * as[2];
         }
-        if (t < MAX_THREADS) part.v[t] = e;
+        e += p->vol[k] * fcr_psi_P(F, pb->mu[k], pb->lambda[k], pb->P + 9 * k);
     }
-    double elastic = 0.0;
-    for (int t = 0; t < part.nt && t < MAX_THREADS; ++t) elastic += part.v[t];
-    pb->elastic_energy = elastic;
+    return e;
+}
 
-    const double *m = pb->grid->mass;
-    const double *g = pb->gravity;
-    Partials kin = {{0}, 1};
-#pragma omp parallel
-    {
-        int t = omp_get_thread_num();
-#pragma omp single
-        kin.nt = omp_get_num_threads();
-        double e = 0.0;
-#pragma omp for schedule(static)
-        for (int i = 0; i < pb->n_nodes; ++i) {
-            const double *d = dv + 3 * (size_t)i;
-            e += m[i] * (0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - dt * (g[0] * d[0] + g[1] * d[1] + g[2] * d[2]));
-        }
-        if (t < MAX_THREADS) kin.v[t] = e;
+/* Inertia and gravity terms of nodes [begin, end). */
+static double inertial_range(const void *ctx, size_t begin, size_t end)
+{
+    const EnergyArgs *ea = ctx;
+    const StepProblem *pb = ea->pb;
+    const double *m = pb->grid->mass, *g = pb->gravity, *dv = ea->dv;
+    double dt = pb->dt, e = 0.0;
+    for (size_t i = begin; i < end; ++i) {
+        const double *d = dv + 3 * i;
+        e += m[i] * (0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - dt * (g[0] * d[0] + g[1] * d[1] + g[2] * d[2]));
     }
-    double inertial = 0.0;
-    for (int t = 0; t < kin.nt && t < MAX_THREADS; ++t) inertial += kin.v[t];
+    return e;
+}
+
+double problem_energy(StepProblem *pb, const double *dv)
+{
+    EnergyArgs ea = {pb, dv};
+    double elastic = reduce_sum(pb->parts->n, 64, elastic_range, &ea);
+    pb->elastic_energy = elastic;
+    double inertial = reduce_sum((size_t)pb->n_nodes, 1024, inertial_range, &ea);
     return inertial + elastic;
 }
 
@@ -664,27 +655,28 @@ void problem_finish_dirichlet(StepProblem *pb)
     pb->n_dirichlet = count;
 }
 
+typedef struct {
+    const double *g, *kappa;
+} CnArgs;
+
+static double cn_range(const void *ctx, size_t begin, size_t end)
+{
+    const CnArgs *ca = ctx;
+    const double *g = ca->g, *kappa = ca->kappa;
+    double s = 0.0;
+    for (size_t i = begin; i < end; ++i) {
+        const double *gi = g + 3 * i;
+        double k = kappa[i];
+        s += (gi[0] * gi[0] + gi[1] * gi[1] + gi[2] * gi[2]) / (k * k);
+    }
+    return s;
+}
+
 double problem_cn_residual(const StepProblem *pb, const double *g)
 {
-    double part[MAX_THREADS] = {0};
-    int nt = 1;
-#pragma omp parallel
-    {
-        int t = omp_get_thread_num();
-#pragma omp single
-        nt = omp_get_num_threads();
-        double s = 0.0;
-#pragma omp for schedule(static)
-        for (int i = 0; i < pb->n_nodes; ++i) {
-            const double *gi = g + 3 * (size_t)i;
-            double k = pb->kappa[i];
-            s += (gi[0] * gi[0] + gi[1] * gi[1] + gi[2] * gi[2]) / (k * k);
-        }
-        if (t < MAX_THREADS) part[t] = s;
-    }
-    double s = 0.0;
-    for (int t = 0; t < nt && t < MAX_THREADS; ++t) s += part[t];
-    return pb->n_nodes > 0 ? sqrt(s / pb->n_nodes) : 0.0;
+    if (pb->n_nodes <= 0) return 0.0;
+    CnArgs ca = {g, pb->kappa};
+    return sqrt(reduce_sum((size_t)pb->n_nodes, 1024, cn_range, &ca) / pb->n_nodes);
 }
 
 double problem_tau(const StepProblem *pb, double eps)

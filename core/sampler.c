@@ -153,7 +153,7 @@ int poisson_tile_create(uint64_t seed, PoissonTile **out)
         free(cell), free(x), free(active), free(t);
         return mpm_error(MPM_EINTERNAL, "out of memory generating the Poisson tile");
     }
-    for (size_t k = 0; k < ncell; ++k) cell[3 * k] = NAN;
+    for (size_t k = 0; k < 3 * ncell; ++k) cell[k] = NAN; /* all three coordinates: no uninitialised reads */
 
     /* neighbour cell offsets that can hold a conflicting sample, near first */
     int off[125][3], noff = 0;

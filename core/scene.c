@@ -5,12 +5,14 @@
 #include "core/scene.h"
 
 #include <dirent.h>
+#include <errno.h>
 #include <jansson.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "core/error.h"
 #include "core/mat3.h"
@@ -49,13 +51,15 @@ static int file_exists(const char *p)
 
 static int cmp_str(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
 
-/* Sorted built-in names (without .json); caller frees each and the array. */
+/* Sorted built-in names (without .json); caller frees each and the array.
+ * Returns -1 without a message when the directory cannot be opened (the
+ * callers word it: listing fails, an unknown name says "none"). */
 static int list_names(char ***names_out, int *n_out)
 {
     *names_out = NULL;
     *n_out = 0;
     DIR *d = opendir(scene_dir());
-    if (!d) return mpm_error(MPM_EINPUT, "cannot open the scene directory %s (set MPM_SCENE_DIR)", scene_dir());
+    if (!d) return -1;
     char **names = NULL;
     int n = 0, cap = 0;
     struct dirent *e;
@@ -75,7 +79,7 @@ static int list_names(char ***names_out, int *n_out)
         ++n;
     }
     closedir(d);
-    qsort(names, (size_t)n, sizeof *names, cmp_str);
+    if (n > 1) qsort(names, (size_t)n, sizeof *names, cmp_str);
     *names_out = names;
     *n_out = n;
     return MPM_OK;
@@ -91,8 +95,8 @@ int scene_list(SceneListFn fn, void *ctx)
 {
     char **names;
     int n;
-    int st = list_names(&names, &n);
-    if (st) return st;
+    if (list_names(&names, &n))
+        return mpm_error(MPM_EINPUT, "cannot open the scene directory %s (set MPM_SCENE_DIR)", scene_dir());
     for (int k = 0; k < n; ++k) {
         char path[2048];
         snprintf(path, sizeof path, "%s/%s.json", scene_dir(), names[k]);
@@ -113,8 +117,9 @@ int scene_list(SceneListFn fn, void *ctx)
  * ====================================================================== */
 
 /* Optional fields that --set may create when absent, by context. */
-static const char *const k_top_optional[] = {"description", "cfl",       "max_dt",  "apic_ratio", "domain_walls",
-                                             "seed",        "colliders", "sources", "transfer",   "position_update",
+static const char *const k_top_optional[] = {"description", "cfl",          "max_dt",          "min_dt",
+                                             "cfl_rule",    "apic_ratio",   "domain_walls",    "seed",
+                                             "colliders",   "sources",      "transfer",        "position_update",
                                              "particle_volume", NULL};
 static const char *const k_mat_optional[] = {"plasticity", NULL};
 static const char *const k_plast_optional[] = {"yield_stress", "theta_c", "theta_s", "hardening",
@@ -327,6 +332,7 @@ typedef struct {
     int has_variation; /* "variation": clumpy density (and snow pre-compaction) */
     double var_amplitude, var_length;
     uint64_t var_seed;
+    double volume;    /* shape_volume once computed (the budget check may need it), else 0 */
 } ObjectSpec;
 
 /* Optional "seed": a non-negative integer, else `default_seed`. */
@@ -694,7 +700,74 @@ static int surface_points(const ObjectSpec *o, double dx, uint64_t seed, SampleP
     return st;
 }
 
-static int sample_objects(Scene *sc, const char *file, ObjectSpec *objs, int nobj)
+size_t scene_default_max_particles(void)
+{
+    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+    if (pages <= 0 || page <= 0) return 1000000; /* unknown memory: a laptop's worth */
+    double n = (double)pages * (double)page / 16384.0;
+    return n < 10000 ? 10000 : (size_t)n;
+}
+
+int scene_parse_particle_budget(const char *flag, const char *text, size_t *out)
+{
+    char *end = NULL;
+    double v = text && text[0] ? strtod(text, &end) : 0.0;
+    if (!end || *end || !(v >= 1 && v <= 1e12) || v != floor(v))
+        return mpm_error(MPM_EINPUT, "%s '%s': expected a whole number of particles in [1, 1e12]", flag,
+                         text ? text : "");
+    *out = (size_t)v;
+    return MPM_OK;
+}
+
+static size_t budget_of(const SceneLoadOptions *opt)
+{
+    return opt && opt->max_particles ? opt->max_particles : scene_default_max_particles();
+}
+
+static void dx_text(char *buf, size_t n, double dx, double scale)
+{
+    if (scale != 1.0)
+        snprintf(buf, n, "dx %g m (dx times --scale %g)", dx, scale);
+    else
+        snprintf(buf, n, "dx %g m", dx);
+}
+
+/* Before any sampling: the estimated particle count of every object, and
+ * of all of them, against the budget. */
+static int check_particle_budget(const Scene *sc, const char *file, ObjectSpec *objs, int nobj, double scale,
+                                 size_t budget)
+{
+    double total = 0.0, largest = 0.0;
+    int big = 0;
+    char dxs[96];
+    dx_text(dxs, sizeof dxs, sc->dx, scale);
+    for (int i = 0; i < nobj; ++i) {
+        ObjectSpec *o = &objs[i];
+        double density = o->sampling == SAMPLING_LATTICE ? 1.0 : SAMPLER_DENSITY;
+        double per_m3 = density * o->ppc / (sc->dx * sc->dx * sc->dx);
+        double vol = shape_volume_bound(o->shape);
+        double est = per_m3 * vol + (double)o->surf_n;
+        if (!(est <= (double)budget)) { /* the cheap bound is loose for CSG: ask the real volume */
+            o->volume = vol = shape_volume(o->shape);
+            est = per_m3 * vol + (double)o->surf_n;
+        }
+        if (!(est <= (double)budget))
+            return mpm_error(MPM_EINPUT,
+                             "%s: objects.%d: ppc %g at %s in a volume of %g m^3 gives about %.3g particles "
+                             "(%zu of them surface_particles), above the particle budget %zu (--max-particles)",
+                             file, i, o->ppc, dxs, vol, est, o->surf_n, budget);
+        total += est;
+        if (est > largest) largest = est, big = i;
+    }
+    if (!(total <= (double)budget))
+        return mpm_error(MPM_EINPUT,
+                         "%s: objects: %d objects at %s give about %.3g particles in total (the most: objects.%d, "
+                         "%.3g), above the particle budget %zu (--max-particles)",
+                         file, nobj, dxs, total, big, largest, budget);
+    return MPM_OK;
+}
+
+static int sample_objects(Scene *sc, const char *file, ObjectSpec *objs, int nobj, size_t budget)
 {
     PoissonTile *own = NULL;
     const PoissonTile *tile = NULL;
@@ -722,12 +795,16 @@ static int sample_objects(Scene *sc, const char *file, ObjectSpec *objs, int nob
         if (!st)
             st = sampler_sample(o->shape, o->sampling, sc->dx, o->ppc, rng_mix(sc->seed, 0x5A00ull + (uint64_t)i),
                                 tile, &pts);
-        if (st) {
-            /* re-issue the sampler's message with the place in the file */
-            char msg[900];
-            snprintf(msg, sizeof msg, "%s", mpm_last_error());
-            mpm_clear_error();
-            mpm_error(st, "%s: %s: %s", file, path, msg);
+        if (st) { /* the sampler's message, prefixed with the place in the file */
+            mpm_error_context(st, "%s: %s", file, path);
+            break;
+        }
+        if (sc->particles.n + pts.n > budget) { /* the estimate is an estimate: the real count decides */
+            st = mpm_error(MPM_EINPUT,
+                           "%s: %s: sampling reached %zu particles (ppc %g at dx %g m), above the particle budget %zu "
+                           "(--max-particles)",
+                           file, path, sc->particles.n + pts.n, o->ppc, sc->dx, budget);
+            sample_points_free(&pts);
             break;
         }
         if (pts.n == 0) {
@@ -736,12 +813,18 @@ static int sample_objects(Scene *sc, const char *file, ObjectSpec *objs, int nob
                            file, path, sc->dx);
             break;
         }
-        double vol = shape_volume(o->shape);
+        double vol = o->volume > 0 ? o->volume : shape_volume(o->shape);
         double vp = vol / (double)pts.n, mass = sc->materials[o->mat].density * vp;
-        if (!(vp > 0) || !isfinite(vp) || !(mass > 0) || !isfinite(mass)) {
+        /* a node's mass can be 1e-30 of a particle's (a B-spline weight near a
+         * stencil's edge): far smaller particle masses underflow to zero node
+         * masses and NaN velocities, far larger ones overflow the energy */
+        if (!(vp > 0) || !isfinite(vp) || !(mass >= 1e-200 && mass <= 1e200)) {
             sample_points_free(&pts);
-            st = mpm_error(MPM_EINPUT, "%s: %s: particle volume %g and mass %g are not positive and finite", file,
-                           path, vp, mass);
+            char mp[512];
+            sj_path(mp, sizeof mp, "materials", sc->materials[o->mat].name);
+            st = mpm_error(MPM_EINPUT,
+                           "%s: %s: particle volume %g m^3 and mass %g kg (%s.density %g) are not in [1e-200, 1e200]",
+                           file, path, vp, mass, mp, sc->materials[o->mat].density);
             break;
         }
         for (size_t k = 0; k < pts.n; ++k) {
@@ -760,12 +843,10 @@ static int sample_objects(Scene *sc, const char *file, ObjectSpec *objs, int nob
         Particles *P = &sc->particles;
         size_t first = P->n;
         if (!st) st = particles_reserve(P, P->n + pts.n);
-        Rng rng, flip;
+        Rng rng, flip; /* seeded even without initial_F: cheap, and no state is ever read uninitialised */
         double diag[3] = {1, 1, 1};
-        if (o->has_F) {
-            rng_seed(&rng, o->F_seed);
-            rng_seed(&flip, rng_mix(o->F_seed, 0x1F11ull)); /* its own stream: the diagonals stay as before */
-        }
+        rng_seed(&rng, o->F_seed);
+        rng_seed(&flip, rng_mix(o->F_seed, 0x1F11ull)); /* its own stream: the diagonals stay as before */
         for (size_t k = 0; k < pts.n && !st; ++k) {
             st = particles_push(P, pts.x + 3 * k, o->velocity, mass, vp, o->mat);
             if (st || !o->has_F) continue;
@@ -882,12 +963,106 @@ static int parse_mpm_options(json_t *root, const char *file, Scene *sc)
     return MPM_OK;
 }
 
+/* Every collider's surface speed over the domain must be finite in each of
+ * its motion phases (an angular velocity of 1e308 deg/s overflows it), so
+ * the CFL rule always sees a number. The first n_scene colliders are the
+ * scene's "colliders" array, the rest come from "sources". */
+static int check_collider_speeds(const Scene *sc, const char *file, size_t n_scene)
+{
+    for (int c = 0; c < sc->n_colliders; ++c) {
+        const Collider *col = &sc->colliders[c];
+        for (int k = 0; k < col->n_phases; ++k) {
+            double t = col->phases[k].t_start;
+            double v = collider_max_speed(col, t, sc->domain_lo, sc->domain_hi);
+            if (isfinite(v)) continue;
+            char where[64];
+            if ((size_t)c < n_scene)
+                snprintf(where, sizeof where, "colliders.%d", c);
+            else
+                snprintf(where, sizeof where, "sources (collider %d)", c);
+            return mpm_error(MPM_EINPUT,
+                             "%s: %s.motion.%d: collider \"%s\" moves at a non-finite speed (%g m/s) over the domain "
+                             "from t = %g s: its velocity or angular_velocity_deg is too large",
+                             file, where, k, col->name, v, t);
+        }
+    }
+    return MPM_OK;
+}
+
+/* The grid must fit the domain: at least one cell across its smallest
+ * extent, and integer node coordinates (|x / dx| < 2^30) everywhere in it. */
+static int check_dx_against_domain(const Scene *sc, const char *file, double scale)
+{
+    double ext = HUGE_VAL, reach = 0.0;
+    for (int d = 0; d < 3; ++d) {
+        ext = fmin(ext, sc->domain_hi[d] - sc->domain_lo[d]);
+        reach = fmax(reach, fmax(fabs(sc->domain_lo[d]), fabs(sc->domain_hi[d])));
+    }
+    char what[200], times[64] = "";
+    if (scale != 1.0) snprintf(times, sizeof times, " (dx times --scale %g)", scale);
+    if (!(sc->dx <= ext)) {
+        snprintf(what, sizeof what, "expected at most the domain's smallest extent %g m%s", ext, times);
+        return sj_bad_number(file, "", "dx", what, sc->dx);
+    }
+    double lo = reach / 1073741824.0;
+    if (!(sc->dx >= lo)) {
+        snprintf(what, sizeof what, "expected at least %g m%s (grid coordinates |x / dx| < 2^30 over the domain)", lo,
+                 times);
+        return sj_bad_number(file, "", "dx", what, sc->dx);
+    }
+    return MPM_OK;
+}
+
+/* min_dt, max_dt and cfl_rule, validated against the frame length 1/fps (a
+ * frame of more than MAX_STEPS_PER_FRAME floor-sized steps is refused). */
+enum { MAX_STEPS_PER_FRAME = 1000000 };
+
+static int parse_time_steps(json_t *root, const char *file, Scene *sc)
+{
+    double frame = 1.0 / sc->fps;
+    char what[160];
+    sc->min_dt = 1e-6; /* the reference's floor (hot-algorithms.md 1.1) */
+    int have_min = 0;
+    int st = sj_positive(root, "min_dt", 0, file, "", &sc->min_dt, &have_min);
+    if (st) return st;
+    if (!have_min && !(sc->min_dt <= frame)) {
+        snprintf(what, sizeof what, "expected at most 1/min_dt = %.6g frames per second", 1.0 / sc->min_dt);
+        return sj_bad_number(file, "", "fps", what, sc->fps);
+    }
+    if (!(sc->min_dt * MAX_STEPS_PER_FRAME >= frame)) {
+        snprintf(what, sizeof what, "expected at least the frame length 1/fps = %.6g s / %d", frame,
+                 MAX_STEPS_PER_FRAME);
+        return sj_bad_number(file, "", "min_dt", what, sc->min_dt);
+    }
+    if (!(sc->min_dt <= frame)) {
+        snprintf(what, sizeof what, "expected at most the frame length 1/fps = %.6g s", frame);
+        return sj_bad_number(file, "", "min_dt", what, sc->min_dt);
+    }
+    sc->max_dt = frame;
+    if ((st = sj_positive(root, "max_dt", 0, file, "", &sc->max_dt, NULL))) return st;
+    if (!(sc->max_dt >= sc->min_dt)) {
+        snprintf(what, sizeof what, "expected at least min_dt = %.6g s (the smallest step)", sc->min_dt);
+        return sj_bad_number(file, "", "max_dt", what, sc->max_dt);
+    }
+    const char *rule = "paper";
+    int have = 0;
+    if ((st = sj_string(root, "cfl_rule", 0, file, "", &rule, &have))) return st;
+    if (strcmp(rule, "paper") == 0)
+        sc->cfl_rule = CFL_RULE_PAPER;
+    else if (strcmp(rule, "reference") == 0)
+        sc->cfl_rule = CFL_RULE_REFERENCE;
+    else
+        return sj_bad(file, "", "cfl_rule", "expected \"paper\" or \"reference\"", json_object_get(root, "cfl_rule"));
+    return MPM_OK;
+}
+
 static int build(json_t *root, const char *file, const SceneLoadOptions *opt, const char *asset_dir, Scene *sc)
 {
-    static const char *const keys[] = {"name",       "description", "dx",     "fps",          "frames",
-                                       "cfl",        "max_dt",      "gravity", "apic_ratio",  "domain",
-                                       "domain_walls", "seed",      "materials", "objects",   "colliders",
-                                       "sources",    "transfer",    "position_update", "particle_volume", NULL};
+    static const char *const keys[] = {"name",       "description", "dx",       "fps",          "frames",
+                                       "cfl",        "max_dt",      "min_dt",   "cfl_rule",     "gravity",
+                                       "apic_ratio", "domain",      "domain_walls", "seed",     "materials",
+                                       "objects",    "colliders",   "sources",  "transfer",     "position_update",
+                                       "particle_volume", NULL};
     int st = sj_check_object(root, file, "", keys);
     if (st) return st;
     if ((st = read_name(root, "name", 1, file, "", sc->name, sizeof sc->name))) return st;
@@ -903,6 +1078,8 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
     if (!(sc->dx > 0) || !isfinite(sc->dx))
         return mpm_error(MPM_EINPUT, "%s: dx: dx times --scale %g is not a positive finite number", file, scale);
     if ((st = sj_positive(root, "fps", 1, file, "", &sc->fps, NULL))) return st;
+    if (!isfinite(1.0 / sc->fps))
+        return sj_bad_number(file, "", "fps", "expected a frame rate whose frame length 1/fps is finite", sc->fps);
     double frames = 0;
     if ((st = sj_number(root, "frames", 1, file, "", &frames, NULL))) return st;
     if (!(frames >= 1 && frames <= 1e9 && frames == floor(frames)))
@@ -910,10 +1087,7 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
     sc->frames = (int)frames;
     sc->cfl = 0.6;
     if ((st = sj_positive(root, "cfl", 0, file, "", &sc->cfl, NULL))) return st;
-    sc->max_dt = 1.0 / sc->fps;
-    if ((st = sj_positive(root, "max_dt", 0, file, "", &sc->max_dt, NULL))) return st;
-    if (!isfinite(sc->max_dt) || !(sc->max_dt > 0))
-        return sj_bad_number(file, "", "max_dt", "expected a positive number", sc->max_dt);
+    if ((st = parse_time_steps(root, file, sc))) return st;
     if ((st = sj_vec3(root, "gravity", 1, file, "", sc->gravity, NULL))) return st;
     sc->apic_ratio = 1.0;
     if ((st = sj_number(root, "apic_ratio", 0, file, "", &sc->apic_ratio, NULL))) return st;
@@ -928,10 +1102,13 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
     if ((st = sj_vec3(dom, "min", 1, file, "domain", sc->domain_lo, NULL))) return st;
     if ((st = sj_vec3(dom, "max", 1, file, "domain", sc->domain_hi, NULL))) return st;
     for (int d = 0; d < 3; ++d)
-        if (!(sc->domain_hi[d] > sc->domain_lo[d]))
-            return sj_bad(file, "domain", "max", "expected max > min on every axis", json_object_get(dom, "max"));
+        if (!(sc->domain_hi[d] > sc->domain_lo[d]) || !isfinite(sc->domain_hi[d] - sc->domain_lo[d]))
+            return sj_bad(file, "domain", "max", "expected max > min on every axis (and a finite extent)",
+                          json_object_get(dom, "max"));
+    if ((st = check_dx_against_domain(sc, file, scale))) return st;
     int walls = 0;
     if ((st = sj_bool(root, "domain_walls", 0, file, "", &walls, NULL))) return st;
+    sc->domain_walls = walls;
     sc->seed = 1;
     json_t *seed = json_object_get(root, "seed");
     if (seed) {
@@ -975,6 +1152,7 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
         sj_path_index(p, sizeof p, "objects", i);
         st = parse_object(json_array_get(objs, i), file, p, (uint64_t)i, sc, asset_dir, scale, &spec[i]);
     }
+    if (!st) st = check_particle_budget(sc, file, spec, (int)nobj, scale, budget_of(opt));
 
     if (!st) st = add_stiffness_materials(sc, file, spec, (int)nobj);
 
@@ -1002,10 +1180,11 @@ static int build(json_t *root, const char *file, const SceneLoadOptions *opt, co
                                    sc->colliders[a].name);
                     break;
                 }
+        if (!st) st = check_collider_speeds(sc, file, nc);
         if (!st && walls) st = add_walls(sc, file);
     }
 
-    if (!st) st = sample_objects(sc, file, spec, (int)nobj);
+    if (!st) st = sample_objects(sc, file, spec, (int)nobj, budget_of(opt));
     if (!st && sc->needs_plasticity) {
         int snow = 0;
         for (int k = 0; k < sc->n_materials; ++k)
@@ -1063,7 +1242,7 @@ int scene_load(const char *name_or_path, const SceneLoadOptions *opt, Scene *out
             char **names;
             int n;
             char list[512] = "";
-            if (list_names(&names, &n) == MPM_OK) {
+            if (list_names(&names, &n) == 0) {
                 size_t used = 0;
                 for (int k = 0; k < n && used + 70 < sizeof list; ++k) {
                     int w = snprintf(list + used, sizeof list - used, "%s%s", k ? ", " : "", names[k]);
@@ -1071,7 +1250,6 @@ int scene_load(const char *name_or_path, const SceneLoadOptions *opt, Scene *out
                 }
                 free_names(names, n);
             }
-            mpm_clear_error(); /* a listing failure must not hide the real message */
             return mpm_error(MPM_EINPUT, "unknown scene \"%s\" (built-in scenes in %s: %s)", name_or_path,
                              scene_dir(), list[0] ? list : "none");
         }
@@ -1079,7 +1257,12 @@ int scene_load(const char *name_or_path, const SceneLoadOptions *opt, Scene *out
         if (strlen(name_or_path) >= sizeof path)
             return mpm_error(MPM_EINPUT, "scene path too long: %.80s...", name_or_path);
         snprintf(path, sizeof path, "%s", name_or_path);
-        if (!file_exists(path)) return mpm_error(MPM_EINPUT, "%s: scene file not found", path);
+        struct stat sb;
+        if (stat(path, &sb) != 0) return mpm_error(MPM_EINPUT, "%s: scene file not found (%s)", path, strerror(errno));
+        if (S_ISDIR(sb.st_mode)) return mpm_error(MPM_EINPUT, "%s: is a directory, not a scene file", path);
+        if (!S_ISREG(sb.st_mode))
+            return mpm_error(MPM_EINPUT, "%s: not a regular file (a device or pipe), not a scene file", path);
+        if (sb.st_size == 0) return mpm_error(MPM_EINPUT, "%s: empty file, not a scene file", path);
     }
     snprintf(out->path, sizeof out->path, "%s", path);
 

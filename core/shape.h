@@ -68,8 +68,21 @@ int shape_contains(const Shape *s, const double x[3]);
  * sides (half-spaces, unions with them). */
 void shape_bounds(const Shape *s, double lo[3], double hi[3]);
 
+/* The bounds the HOT authors' code gives the shape, for the reference CFL
+ * rule (collider_max_speed_reference): an untransformed cylinder is bounded
+ * by the box of its circumscribed sphere, centre +- sqrt(r^2 + (h/2)^2) on
+ * every axis (this reproduces their bar3 dt 0.0024565 s, SPEC 12); every
+ * other shape by shape_bounds. */
+void shape_reference_bounds(const Shape *s, double lo[3], double hi[3]);
+
 /* 1 if every side of the bounds is finite. */
 int shape_is_bounded(const Shape *s);
+
+/* A cheap upper bound of the volume (for budgets before sampling): exact for
+ * primitives and meshes, for CSG the sum (union), smallest (intersection)
+ * or first (difference) of the children's bounds, never above the bounding
+ * box's volume. HUGE_VAL when unbounded. */
+double shape_volume_bound(const Shape *s);
 
 /* Volume: exact for primitives (times scale^3), the mesh's enclosed volume
  * for meshes, and for CSG a deterministic adaptive-octree estimate (relative

@@ -178,13 +178,7 @@ int source_parse(json_t *j, const char *file, const char *jpath, const char *ass
     if (!st && s.has_collider) st = collider_parse_named(cj, file, jpath, asset_dir, dx, s.name, collider);
     json_decref(cj);
     if (!st) {
-        st = make_samples(&s, tile, dx);
-        if (st) {
-            char msg[700];
-            snprintf(msg, sizeof msg, "%s", mpm_last_error());
-            mpm_clear_error();
-            st = mpm_error(st, "%s: %s: %s", file, jpath, msg);
-        }
+        st = mpm_error_context(make_samples(&s, tile, dx), "%s: %s", file, jpath);
     }
     if (st) {
         source_free(&s);

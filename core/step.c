@@ -1,6 +1,7 @@
 #include "core/step.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -127,39 +128,54 @@ void sim_free(Simulation *sim)
     memset(sim, 0, sizeof *sim);
 }
 
-double sim_next_dt(const Simulation *sim)
+int sim_next_dt(const Simulation *sim, double *dt_out)
 {
     const Scene *sc = sim->scene;
     const Particles *p = &sim->p;
     double vmax = 0.0;
+    size_t fastest = 0;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (size_t k = 0; k < p->n; ++k) {
         const double *v = p->v + 3 * k, *x = p->x + 3 * k;
         double s = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-        if (s > vmax) vmax = s;
+        if (s > vmax || isnan(s)) vmax = s, fastest = k; /* a NaN is kept (s > NaN is false) and refused below */
         for (int d = 0; d < 3; ++d) {
             if (x[d] < lo[d]) lo[d] = x[d];
             if (x[d] > hi[d]) hi[d] = x[d];
         }
     }
     vmax = sqrt(vmax);
+    const char *who = "particle";
+    int collider = -1;
     /* collider surface speeds over the particle box enlarged by 4 dx (reference §1.1) */
     for (int d = 0; d < 3; ++d) {
         lo[d] -= 4 * sc->dx;
         hi[d] += 4 * sc->dx;
     }
     for (int c = 0; c < sc->n_colliders; ++c) {
-        if (!collider_active(&sc->colliders[c], sim->t)) continue;
-        double s = collider_max_speed(&sc->colliders[c], sim->t, lo, hi);
-        if (s > vmax) vmax = s;
+        const Collider *col = &sc->colliders[c];
+        if (!collider_active(col, sim->t)) continue;
+        double s = sc->cfl_rule == CFL_RULE_REFERENCE ? collider_max_speed_reference(col, sim->t, lo, hi)
+                                                      : collider_max_speed(col, sim->t, lo, hi);
+        if (s > vmax || isnan(s)) vmax = s, who = "collider", collider = c;
     }
+    char name[96];
+    if (collider >= 0)
+        snprintf(name, sizeof name, "collider %s", sc->colliders[collider].name);
+    else
+        snprintf(name, sizeof name, "%s %zu", who, fastest);
+    if (!isfinite(vmax))
+        return mpm_error(MPM_ENUMERIC, "t = %.9g s: the CFL speed of %s is not finite (%g m/s)", sim->t, name, vmax);
     double dt = vmax > 0.0 ? sc->cfl * sc->dx / vmax : sc->max_dt;
     if (dt > sc->max_dt) dt = sc->max_dt;
-    if (dt < 1e-6) dt = 1e-6;
+    if (!(dt >= sc->min_dt))
+        return mpm_error(MPM_ENUMERIC, "t = %.9g s: the CFL step %g s (speed %g m/s of %s) is below min_dt %g s",
+                         sim->t, dt, vmax, name, sc->min_dt);
     double rest = sim->frame_dt - sim->t_in_frame;
     if (sim->t_in_frame + dt >= sim->frame_dt) dt = rest;
     else if (sim->t_in_frame + 2 * dt > sim->frame_dt) dt = 0.5 * rest;
-    return dt;
+    *dt_out = dt;
+    return MPM_OK;
 }
 
 /* Dirichlet nodes from colliders posed at t^n (SPEC 2 item 3): sticky wins,
@@ -190,20 +206,99 @@ static void collider_dirichlet(const void *ctx, StepProblem *pb, int i, const do
     }
 }
 
+/* Every active node must get a positive, finite mass from P2G (its velocity
+ * is momentum / mass): under- or overflow is a numerical breakdown. */
+static int check_node_masses(const Simulation *sim)
+{
+    const Grid *g = &sim->grid;
+    int bad = g->n;
+#pragma omp parallel for schedule(static) reduction(min : bad)
+    for (int i = 0; i < g->n; ++i)
+        if (!(g->mass[i] > 0.0 && g->mass[i] <= 1e300) && i < bad) bad = i;
+    if (bad == g->n) return MPM_OK;
+    const double dx = g->dx;
+    return mpm_error(MPM_ENUMERIC, "t = %.9g s: grid node %d at (%g, %g, %g) got mass %g from P2G", sim->t, bad,
+                     g->coord[3 * bad] * dx, g->coord[3 * bad + 1] * dx, g->coord[3 * bad + 2] * dx, g->mass[bad]);
+}
+
 int step_begin(Simulation *sim)
 {
     const Scene *sc = sim->scene;
     int st;
-    sim->dt = sim->dt_next > 0.0 ? sim->dt_next : sim_next_dt(sim);
+    if (sim->dt_next > 0.0) sim->dt = sim->dt_next; /* a replayed step (--dt-from) */
+    else if ((st = sim_next_dt(sim, &sim->dt))) return st;
     sim->dt_next = 0.0;
     if ((st = grid_build(&sim->grid, &sim->st, &sim->p, sc->dx))) return st;
     transfer_p2g(&sim->grid, &sim->st, &sim->p);
+    if ((st = check_node_masses(sim))) return st;
     estimate_volumes(sim);
     if ((st = problem_prepare(&sim->pb, &sim->grid, &sim->st, &sim->p, sc->materials, sc->n_materials, sim->dt,
                               sc->gravity)))
         return st;
     problem_mark_dirichlet(&sim->pb, sc->n_colliders ? collider_dirichlet : NULL, sim);
     return MPM_OK;
+}
+
+/* With domain walls the domain faces are sticky walls, but a particle
+ * within 1.5 dx of one still takes velocity from free nodes inside, so
+ * G2P's x += dt v can carry it across the face (it stops only once no free
+ * node reaches it, half a cell in, and a fast particle overshoots in one
+ * step). Material reaching a sticky wall stays there: the particle is put
+ * back on the face and its outward velocity removed. Particles that stay
+ * inside are untouched, so runs that never reach a wall do not change. */
+static void hold_at_walls(Simulation *sim)
+{
+    const Scene *sc = sim->scene;
+    Particles *p = &sim->p;
+#pragma omp parallel for schedule(static)
+    for (size_t k = 0; k < p->n; ++k)
+        for (int d = 0; d < 3; ++d) {
+            double *x = p->x + 3 * k + d, *v = p->v + 3 * k + d;
+            if (*x < sc->domain_lo[d]) {
+                *x = sc->domain_lo[d];
+                if (*v < 0) *v = 0;
+            } else if (*x > sc->domain_hi[d]) {
+                *x = sc->domain_hi[d];
+                if (*v > 0) *v = 0;
+            }
+        }
+}
+
+static int finite9(const double *a)
+{
+    double s = 0.0;
+    for (int k = 0; k < 9; ++k) s += a[k] * 0.0;
+    return s == 0.0; /* x * 0 is NaN exactly for NaN and infinite x */
+}
+
+/* The state after a step: finite positions, velocities and F, and every
+ * particle inside the domain. A failure is a numerical breakdown of the
+ * step (MPM_ENUMERIC) naming the lowest such particle. */
+static int check_state(const Simulation *sim)
+{
+    const Scene *sc = sim->scene;
+    const Particles *p = &sim->p;
+    size_t bad = p->n;
+#pragma omp parallel for schedule(static) reduction(min : bad)
+    for (size_t k = 0; k < p->n; ++k) {
+        const double *x = p->x + 3 * k, *v = p->v + 3 * k;
+        int ok = finite9(p->F + 9 * k) && isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
+        for (int d = 0; d < 3; ++d) ok &= x[d] >= sc->domain_lo[d] && x[d] <= sc->domain_hi[d];
+        if (!ok && k < bad) bad = k;
+    }
+    if (bad == p->n) return MPM_OK;
+    const double *x = p->x + 3 * bad, *v = p->v + 3 * bad, *F = p->F + 9 * bad;
+    int finite = finite9(F) && isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]) && isfinite(x[0]) &&
+                 isfinite(x[1]) && isfinite(x[2]);
+    if (!finite)
+        return mpm_error(MPM_ENUMERIC,
+                         "t = %.9g s: particle %zu became non-finite (x = (%g, %g, %g), v = (%g, %g, %g), F00 = %g)",
+                         sim->t, bad, x[0], x[1], x[2], v[0], v[1], v[2], F[0]);
+    return mpm_error(MPM_ENUMERIC,
+                     "t = %.9g s: particle %zu at (%g, %g, %g) left the domain [%g, %g, %g]-[%g, %g, %g]%s",
+                     sim->t, bad, x[0], x[1], x[2], sc->domain_lo[0], sc->domain_lo[1], sc->domain_lo[2],
+                     sc->domain_hi[0], sc->domain_hi[1], sc->domain_hi[2],
+                     sc->domain_walls ? "" : " (no domain_walls)");
 }
 
 int step_end(Simulation *sim, const double *dv)
@@ -232,21 +327,6 @@ int step_end(Simulation *sim, const double *dv)
         sim->t_in_frame = 0.0;
         sim->frame++;
     }
-    /* a NaN or a particle that left the domain ends the run with a message */
-    const Particles *p = &sim->p;
-    size_t bad = (size_t)-1;
-    for (size_t k = 0; k < p->n && bad == (size_t)-1; ++k)
-        for (int d = 0; d < 3; ++d) {
-            double x = p->x[3 * k + d];
-            if (!isfinite(x) || x < sc->domain_lo[d] || x > sc->domain_hi[d]) {
-                bad = k;
-                break;
-            }
-        }
-    if (bad != (size_t)-1) {
-        const double *x = p->x + 3 * bad;
-        return mpm_error(MPM_EINTERNAL, "particle %zu at (%g, %g, %g) left the domain or became non-finite at t = %g s",
-                         bad, x[0], x[1], x[2], sim->t);
-    }
-    return MPM_OK;
+    if (sc->domain_walls) hold_at_walls(sim);
+    return check_state(sim);
 }

@@ -4,7 +4,9 @@
  *   step_end:   v^{n+1} = v^n + dv, Coulomb friction at slip colliders,
  *               G2P (APIC/RPIC or PIC/FLIP, F update, forward-Euler
  *               advection or the backward-Euler position update),
- *               plasticity (lagged), domain and finiteness checks.
+ *               plasticity (lagged), sources; particles that crossed a
+ *               domain wall are held at its face; non-finite state or a
+ *               particle outside a wall-less domain is MPM_ENUMERIC.
  * The first step_begin also estimates particle volumes from the grid
  * density when the scene asks ("particle_volume": "grid_density"). */
 #ifndef MPM_STEP_H
@@ -41,9 +43,11 @@ typedef struct {
 int sim_init(Simulation *sim, const Scene *scene);
 void sim_free(Simulation *sim);
 
-/* dt rule of SPEC 2.1: cfl dx / vmax clamped to [1e-6, max_dt], then hitting
- * frame boundaries exactly. */
-double sim_next_dt(const Simulation *sim);
+/* dt rule of SPEC 2.1: cfl dx / vmax capped at max_dt, then hitting frame
+ * boundaries exactly. vmax counts the colliders by the scene's cfl_rule. A
+ * non-finite vmax, or a CFL dt below the scene's min_dt (which used to be
+ * raised to the floor silently, breaking the CFL limit), is MPM_ENUMERIC. */
+int sim_next_dt(const Simulation *sim, double *dt);
 
 int step_begin(Simulation *sim);
 /* dv is the solver's result over the step problem's nodes. */

@@ -8,6 +8,7 @@ void transfer_p2g(Grid *g, const Stencils *st, const Particles *p)
 {
     int n = g->n;
     double dx = g->dx;
+    if (n == 0) return; /* no particles: no nodes (and possibly no arrays yet) */
     memset(g->mass, 0, sizeof(double) * (size_t)n);
     memset(g->v, 0, sizeof(double) * 3 * (size_t)n);
     const NodeColoring *pc = &st->pcolor;

@@ -1,29 +1,26 @@
 #include "core/vec.h"
 
-#include <omp.h>
 #include <string.h>
 
 #include "core/mat3.h"
+#include "core/reduce.h"
 
-#define MAX_THREADS 256
+typedef struct {
+    const double *a, *b;
+} DotArgs;
+
+static double dot_range(const void *ctx, size_t begin, size_t end)
+{
+    const DotArgs *d = ctx;
+    double s = 0.0;
+    for (size_t i = begin; i < end; ++i) s += d->a[i] * d->b[i];
+    return s;
+}
 
 double vec_dot(size_t len, const double *a, const double *b)
 {
-    double part[MAX_THREADS] = {0};
-    int nt = 1;
-#pragma omp parallel
-    {
-        int t = omp_get_thread_num();
-#pragma omp single
-        nt = omp_get_num_threads();
-        double s = 0.0;
-#pragma omp for schedule(static)
-        for (size_t i = 0; i < len; ++i) s += a[i] * b[i];
-        if (t < MAX_THREADS) part[t] = s;
-    }
-    double s = 0.0;
-    for (int t = 0; t < nt && t < MAX_THREADS; ++t) s += part[t];
-    return s;
+    DotArgs d = {a, b};
+    return reduce_sum(len, 4096, dot_range, &d);
 }
 
 double vec_norm(size_t len, const double *a) { return sqrt(vec_dot(len, a, a)); }
@@ -42,10 +39,13 @@ void vec_xpby(size_t len, const double *restrict x, double beta, double *restric
 
 void vec_copy(size_t len, const double *x, double *y)
 {
-    if (x != y) memcpy(y, x, len * sizeof(double));
+    if (x != y && len) memcpy(y, x, len * sizeof(double));
 }
 
-void vec_zero(size_t len, double *x) { memset(x, 0, len * sizeof(double)); }
+void vec_zero(size_t len, double *x)
+{
+    if (len) memset(x, 0, len * sizeof(double));
+}
 
 void vec_scale(size_t len, double alpha, double *x)
 {

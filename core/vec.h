@@ -1,6 +1,6 @@
 /* Vector kernels over node-major 3-vectors (length 3n). OpenMP-parallel;
- * reductions sum per-thread partials in thread order, so results are
- * identical run to run for a fixed thread count. */
+ * dot products sum fixed chunks in order (core/reduce.h), so results are
+ * identical for every thread count. Zero lengths accept NULL pointers. */
 #ifndef MPM_VEC_H
 #define MPM_VEC_H
 

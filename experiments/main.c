@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/threads.h"
 #include "experiments/bench.h"
 #include "experiments/matrix_cmd.h"
 #include "experiments/registry.h"
@@ -20,7 +21,7 @@ static void usage(FILE *f)
             "  mpmbench list solvers|scenes\n"
             "  mpmbench run --scene NAME|FILE --solver NAME|OUTER:INVERSE[:key=value,...] [--frames N] [--eps E]\n"
             "               [--scale S] [--threads T] [--out DIR] [--set key=value ...] [--solver-opt key=value ...]\n"
-            "               [--history] [--particles DIR] [--asset-dir DIR] [--armijo] [--quiet]\n"
+            "               [--history] [--particles DIR] [--asset-dir DIR] [--armijo] [--quiet] [--max-particles N]\n"
             "               [--max-outer N] [--max-linear N] [--max-step-seconds S] [--max-run-seconds S]\n"
             "               [--on-failure stop|continue] [--error-ref SOLVER[:eps]|auto[:eps]] [--trajectory]\n"
             "               [--dt-from RUN_DIR] [--trajectory-ref RUN_DIR]\n"
@@ -117,8 +118,10 @@ static int parse_args(int argc, char **argv, int first, Args *a)
         else if (!strcmp(f, "--scale")) { NEED_VAL(); if ((st = parse_double(f, val, &c->scale))) return st; }
         else if (!strcmp(f, "--threads")) {
             NEED_VAL();
-            if ((st = parse_int(f, val, &c->threads))) return st;
-            if (c->threads < 1) return mpm_error(MPM_EINPUT, "--threads %d: expected >= 1", c->threads);
+            if ((st = threads_parse(f, val, &c->threads))) return st;
+        } else if (!strcmp(f, "--max-particles")) {
+            NEED_VAL();
+            if ((st = scene_parse_particle_budget(f, val, &c->max_particles))) return st;
         } else if (!strcmp(f, "--out")) { NEED_VAL(); c->out_dir = val; }
         else if (!strcmp(f, "--particles")) { NEED_VAL(); c->particles_dir = val; }
         else if (!strcmp(f, "--error-ref")) { NEED_VAL(); c->error_ref = val; }
@@ -189,8 +192,9 @@ int main(int argc, char **argv)
         usage(argc < 2 ? stderr : stdout);
         return argc < 2 ? MPM_EINPUT : 0;
     }
-    int st;
-    if (!strcmp(argv[1], "list")) st = cmd_list(argc, argv);
+    int st = threads_check_env(); /* before OpenMP reads it at the first parallel region */
+    if (st) {
+    } else if (!strcmp(argv[1], "list")) st = cmd_list(argc, argv);
     else if (!strcmp(argv[1], "run")) st = cmd_run(argc, argv);
     else if (!strcmp(argv[1], "bench")) st = cmd_bench(argc, argv);
     else if (!strcmp(argv[1], "render")) st = render_command(argc, argv);

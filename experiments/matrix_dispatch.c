@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "experiments/matrix_child.h"
 #include "experiments/matrix_results.h"
+#include "experiments/paths.h"
 
 enum { TAG_REQUEST = 1, TAG_TASK = 2, TAG_STOP = 3, TAG_RESULT = 4 };
 enum { POLL_MS = 5, MAX_ARGS = 512 };
@@ -60,7 +61,7 @@ static int slot_start(Slot *s, const MatrixTask *t)
     }
     /* whatever is there is a cell that did not finish: redo it from scratch */
     int st = matrix_remove_tree(t->dir);
-    if (!st) st = matrix_mkdir_p(t->dir);
+    if (!st) st = paths_mkdir_p(t->dir);
     if (st) return st;
     write_command(&s->task, args);
     if ((st = cell_child_start(args, t->argc, t->dir, t->timeout_s, &s->child))) return st;

@@ -13,20 +13,7 @@
 #include <unistd.h>
 
 #include "core/error.h"
-
-int matrix_mkdir_p(const char *path)
-{
-    char buf[1200];
-    if (snprintf(buf, sizeof buf, "%s", path) >= (int)sizeof buf) return mpm_error(MPM_EINPUT, "%s: path too long", path);
-    for (char *s = buf + 1; *s; ++s) {
-        if (*s != '/') continue;
-        *s = '\0';
-        if (mkdir(buf, 0755) != 0 && errno != EEXIST) return mpm_error(MPM_EINPUT, "%s: cannot create directory", buf);
-        *s = '/';
-    }
-    if (mkdir(buf, 0755) != 0 && errno != EEXIST) return mpm_error(MPM_EINPUT, "%s: cannot create directory", buf);
-    return MPM_OK;
-}
+#include "experiments/paths.h"
 
 static int remove_entry(const char *path, const struct stat *sb, int flag, struct FTW *ftw)
 {

@@ -55,8 +55,6 @@ double cells_file_estimate(const CellsFile *f, const char *scene, const char *so
 int cells_file_append(CellsFile *f, const char *row);
 void cells_file_close(CellsFile *f);
 
-/* mkdir -p */
-int matrix_mkdir_p(const char *path);
 /* rm -rf of a cell directory (never follows symbolic links) */
 int matrix_remove_tree(const char *path);
 

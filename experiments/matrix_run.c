@@ -15,6 +15,7 @@
 #include "experiments/matrix_dispatch.h"
 #include "experiments/matrix_file.h"
 #include "experiments/matrix_results.h"
+#include "experiments/paths.h"
 #include "experiments/matrix_validate.h"
 #include "experiments/provenance.h"
 
@@ -351,7 +352,7 @@ static int prepare(Run *r, const char *file, const MatrixRunOptions *o, int use_
     }
     cells_file_close(&r->results);
     snprintf(cells_dir, sizeof cells_dir, "%s/cells", r->dir);
-    if ((st = matrix_mkdir_p(cells_dir))) return st;
+    if ((st = paths_mkdir_p(cells_dir))) return st;
     if ((st = cells_file_open(r->dir, header, 1, fill_column, r, &r->results))) return st;
     if (use_mpi && ranks > 1) order_by_estimate(r);
     if ((st = write_metadata(r, ranks, o->jobs))) return st;

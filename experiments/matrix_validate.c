@@ -80,7 +80,8 @@ static int check_scene(const Matrix *m, const MatrixCell *c)
     }
     char path[2048];
     matrix_scene_path(m, c->scene, path, sizeof path);
-    SceneLoadOptions lo = {c->scale, ov, c->n_set, c->asset_dir[0] ? c->asset_dir : NULL};
+    SceneLoadOptions lo = {.scale = c->scale, .overrides = ov, .n_overrides = c->n_set,
+                           .asset_dir = c->asset_dir[0] ? c->asset_dir : NULL};
     Scene sc;
     int st = scene_load(path, &lo, &sc);
     int frames = sc.frames;

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/threads.h"
 #include "core/step.h"
 #include "experiments/progress.h"
 #include "experiments/registry.h"
@@ -19,11 +20,13 @@
 #define RC_MAX_SET 64
 #define RC_DEFAULT_LONG_SIDE 800
 #define RC_MIN_SHORT_SIDE 160
+#define RC_MAX_SIDE 16384
 #define RC_FRAME_SAMPLES 40 /* per axis, collider neighbourhood sampling */
 
 typedef struct {
     const char *scene, *solver, *out, *asset_dir;
     int frame, width, height, threads;
+    size_t max_particles;
     double scale;
     char view[8];
     int color_by;
@@ -40,6 +43,17 @@ static int rc_int(const char *flag, const char *s, int lo, int *out)
     long v = strtol(s, &end, 10);
     if (!s[0] || *end || v < lo || v > 1000000000L)
         return mpm_error(MPM_EINPUT, "%s '%s': expected an integer >= %d", flag, s, lo);
+    *out = (int)v;
+    return MPM_OK;
+}
+
+/* An image side in pixels: [1, RC_MAX_SIDE]. */
+static int rc_side(const char *flag, const char *s, int *out)
+{
+    char *end = NULL;
+    long v = strtol(s, &end, 10);
+    if (!s[0] || *end || v < 1 || v > RC_MAX_SIDE)
+        return mpm_error(MPM_EINPUT, "%s '%s': expected an image size in pixels in [1, %d]", flag, s, RC_MAX_SIDE);
     *out = (int)v;
     return MPM_OK;
 }
@@ -68,7 +82,7 @@ static int parse_render_args(int argc, char **argv, RenderArgs *a)
             if (!strcmp(f, "--scene") || !strcmp(f, "--frame") || !strcmp(f, "--out") || !strcmp(f, "--solver") ||
                 !strcmp(f, "--scale") || !strcmp(f, "--set") || !strcmp(f, "--view") || !strcmp(f, "--color") ||
                 !strcmp(f, "--width") || !strcmp(f, "--height") || !strcmp(f, "--asset-dir") ||
-                !strcmp(f, "--threads"))
+                !strcmp(f, "--threads") || !strcmp(f, "--max-particles"))
                 return mpm_error(MPM_EINPUT, "%s: missing value", f);
             return mpm_error(MPM_EINPUT, "render: unknown option '%s' (see: mpmbench --help)", f);
         }
@@ -78,9 +92,10 @@ static int parse_render_args(int argc, char **argv, RenderArgs *a)
         else if (!strcmp(f, "--out")) a->out = v;
         else if (!strcmp(f, "--asset-dir")) a->asset_dir = v;
         else if (!strcmp(f, "--frame")) { if ((st = rc_int(f, v, 0, &a->frame))) return st; }
-        else if (!strcmp(f, "--width")) { if ((st = rc_int(f, v, 1, &a->width))) return st; }
-        else if (!strcmp(f, "--height")) { if ((st = rc_int(f, v, 1, &a->height))) return st; }
-        else if (!strcmp(f, "--threads")) { if ((st = rc_int(f, v, 1, &a->threads))) return st; }
+        else if (!strcmp(f, "--width")) { if ((st = rc_side(f, v, &a->width))) return st; }
+        else if (!strcmp(f, "--height")) { if ((st = rc_side(f, v, &a->height))) return st; }
+        else if (!strcmp(f, "--threads")) { if ((st = threads_parse(f, v, &a->threads))) return st; }
+        else if (!strcmp(f, "--max-particles")) { if ((st = scene_parse_particle_budget(f, v, &a->max_particles))) return st; }
         else if (!strcmp(f, "--scale")) { if ((st = rc_double(f, v, &a->scale))) return st; }
         else if (!strcmp(f, "--view")) {
             if (strcmp(v, "front") && strcmp(v, "side") && strcmp(v, "top") && strcmp(v, "iso"))
@@ -105,8 +120,6 @@ static int parse_render_args(int argc, char **argv, RenderArgs *a)
             return mpm_error(MPM_EINPUT, "render: unknown option '%s' (see: mpmbench --help)", f);
     }
     if (!a->scene) return mpm_error(MPM_EINPUT, "render: --scene is required");
-    if (a->width > 16384 || a->height > 16384)
-        return mpm_error(MPM_EINPUT, "render: image size %dx%d too large (at most 16384 a side)", a->width, a->height);
     if (a->out && !a->out[0]) return mpm_error(MPM_EINPUT, "--out: empty file name");
     return MPM_OK;
 }
@@ -277,10 +290,10 @@ static void image_size(const RenderArgs *a, const double lo[3], const double hi[
         if (h < RC_MIN_SHORT_SIDE) h = RC_MIN_SHORT_SIDE;
     } else if (!h) {
         double hh = w / aspect;
-        h = hh < 1 ? 1 : (hh > 16384 ? 16384 : (int)lround(hh));
+        h = hh < 1 ? 1 : (hh > RC_MAX_SIDE ? RC_MAX_SIDE : (int)lround(hh));
     } else if (!w) {
         double ww = h * aspect;
-        w = ww < 1 ? 1 : (ww > 16384 ? 16384 : (int)lround(ww));
+        w = ww < 1 ? 1 : (ww > RC_MAX_SIDE ? RC_MAX_SIDE : (int)lround(ww));
     }
     *W = w;
     *H = h;
@@ -413,7 +426,8 @@ int render_command(int argc, char **argv)
     if (a.threads > 0) omp_set_num_threads(a.threads);
 
     Scene scene;
-    SceneLoadOptions lo = {a.scale, a.ov, a.n_ov, a.asset_dir};
+    SceneLoadOptions lo = {.scale = a.scale, .overrides = a.ov, .n_overrides = a.n_ov, .asset_dir = a.asset_dir,
+                           .max_particles = a.max_particles};
     if ((status = scene_load(a.scene, &lo, &scene))) {
         solver_destroy(solver);
         return status;

@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/step.h"
 #include "experiments/library_startup.h"
+#include "experiments/paths.h"
 #include "experiments/ply.h"
 #include "experiments/progress.h"
 #include "experiments/provenance.h"
@@ -45,16 +46,6 @@ static int solver_option_list(const RunConfig *cfg, const char **list)
     return n;
 }
 
-static int check_dir_arg(const char *flag, const char *path)
-{
-    if (!path) return MPM_OK;
-    if (!path[0]) return mpm_error(MPM_EINPUT, "%s '': expected a directory", flag);
-    struct stat sb;
-    if (stat(path, &sb) == 0 && !S_ISDIR(sb.st_mode))
-        return mpm_error(MPM_EINPUT, "%s %s: exists and is not a directory", flag, path);
-    return MPM_OK;
-}
-
 static AccuracyConfig accuracy_config(const RunConfig *cfg)
 {
     AccuracyConfig a = {cfg->error_ref, cfg->dt_from, cfg->trajectory_ref, cfg->trajectory};
@@ -83,27 +74,13 @@ int run_config_check(const RunConfig *cfg)
     SolveSettings set;
     run_solve_settings(cfg, &set);
     if ((st = solve_settings_check(&set))) return st;
-    if ((st = check_dir_arg("--out", cfg->out_dir))) return st;
-    if ((st = check_dir_arg("--particles", cfg->particles_dir))) return st;
+    if ((st = paths_check_output_dir("--out", cfg->out_dir))) return st;
+    if ((st = paths_check_output_dir("--particles", cfg->particles_dir))) return st;
     AccuracyConfig acc = accuracy_config(cfg);
     if ((st = run_accuracy_check(&acc))) return st;
     const char *opts[RUN_MAX_SOLVER_OPTS];
     int n = solver_option_list(cfg, opts);
     return solver_spec_check(cfg->solver, opts, n);
-}
-
-static int mkdir_p(const char *path)
-{
-    char buf[1024];
-    if (snprintf(buf, sizeof buf, "%s", path) >= (int)sizeof buf) return mpm_error(MPM_EINPUT, "%s: path too long", path);
-    for (char *s = buf + 1; *s; ++s) {
-        if (*s != '/') continue;
-        *s = '\0';
-        if (mkdir(buf, 0755) != 0 && errno != EEXIST) return mpm_error(MPM_EINPUT, "%s: cannot create directory", buf);
-        *s = '/';
-    }
-    if (mkdir(buf, 0755) != 0 && errno != EEXIST) return mpm_error(MPM_EINPUT, "%s: cannot create directory", buf);
-    return MPM_OK;
 }
 
 static FILE *open_in(const char *dir, const char *name, int *status)
@@ -276,7 +253,8 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     }
 
     Scene scene;
-    SceneLoadOptions lo = {cfg->scale, cfg->overrides, cfg->n_overrides, cfg->asset_dir};
+    SceneLoadOptions lo = {.scale = cfg->scale, .overrides = cfg->overrides, .n_overrides = cfg->n_overrides,
+                           .asset_dir = cfg->asset_dir, .max_particles = cfg->max_particles};
     if ((status = scene_load(cfg->scene, &lo, &scene))) {
         run_accuracy_free(&acc);
         solver_destroy(solver);
@@ -298,8 +276,8 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     memset(&sim, 0, sizeof sim);
     FILE *steps_csv = NULL, *frames_csv = NULL, *iters_csv = NULL;
     StepWork work = {.dv = NULL, .cap = 0};
-    if ((status = mkdir_p(out_dir))) goto done;
-    if (cfg->particles_dir && (status = mkdir_p(cfg->particles_dir))) goto done;
+    if ((status = paths_mkdir_p(out_dir))) goto done;
+    if (cfg->particles_dir && (status = paths_mkdir_p(cfg->particles_dir))) goto done;
     if (!(steps_csv = open_in(out_dir, "steps.csv", &status))) goto done;
     if (!(frames_csv = open_in(out_dir, "frames.csv", &status))) goto done;
     if (cfg->history && !(iters_csv = open_in(out_dir, "iters.csv", &status))) goto done;

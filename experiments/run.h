@@ -44,6 +44,7 @@ typedef struct {
     const char *dt_from;        /* --dt-from RUN_DIR */
     const char *trajectory_ref; /* --trajectory-ref RUN_DIR */
     int trajectory;             /* --trajectory: OUT/trajectory.bin */
+    size_t max_particles;       /* particle budget (--max-particles); 0: scene_default_max_particles() */
 } RunConfig;
 
 typedef struct {

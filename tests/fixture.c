@@ -71,7 +71,7 @@ void fixture_free(Fixture *f)
 int scene_step_open(SceneStep *s, const char *scene, double scale)
 {
     memset(s, 0, sizeof *s);
-    SceneLoadOptions lo = {scale, NULL, 0, NULL};
+    SceneLoadOptions lo = {.scale = scale};
     int st = scene_load(scene, &lo, &s->sc);
     if (st) return st;
     s->loaded = 1;

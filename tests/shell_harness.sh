@@ -33,5 +33,6 @@ expect_input_error() {
 
 finish() {
   echo "$((checks - fails)) passed, $fails failed"
+  if [ "$checks" -eq 0 ]; then echo "FAIL: no checks ran"; return 1; fi
   [ "$fails" -eq 0 ]
 }

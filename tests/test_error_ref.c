@@ -36,7 +36,7 @@ static void first_step(const char *scene, double scale, const char *const *set, 
         ov[i].value = set[2 * i + 1];
     }
     Scene sc;
-    SceneLoadOptions lo = {scale, ov, n_set, NULL};
+    SceneLoadOptions lo = {.scale = scale, .overrides = ov, .n_overrides = n_set};
     int st = scene_load(scene, &lo, &sc);
     CHECK(st == MPM_OK, "scene %s: %s", scene, mpm_last_error());
     if (st) return;
@@ -160,7 +160,7 @@ static int slow_hook(void *ctx, StepProblem *pb, const double *dv)
 static void hook_time_and_cache(void)
 {
     Scene sc;
-    SceneLoadOptions lo = {4.0, NULL, 0, NULL};
+    SceneLoadOptions lo = {.scale = 4.0};
     int st = scene_load("bar3", &lo, &sc);
     CHECK(st == MPM_OK, "scene: %s", mpm_last_error());
     if (st) return;

@@ -25,7 +25,7 @@ int main(void)
                             {"particle_volume", "grid_density"}, {"colliders.0.type", "slip"},
                             {"colliders.0.friction", "0.4"},
                             {"objects.0.variation", "{\"amplitude\": 0.1, \"length\": 0.03}"}};
-    SceneLoadOptions go = {1.0, good, 6, NULL};
+    SceneLoadOptions go = {.scale = 1.0, .overrides = good, .n_overrides = 6};
     mpm_clear_error();
     CHECK(scene_load("drop", &go, &s) == 0, "good values: %s", mpm_last_error());
     CHECK(s.transfer == TRANSFER_PIC_FLIP && s.flip_alpha == 0.0 && s.position_update == POSITION_BACKWARD_EULER &&
@@ -51,7 +51,7 @@ int main(void)
     };
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
         SceneOverride ov = {bad[k].key, bad[k].value};
-        SceneLoadOptions o = {1.0, &ov, 1, NULL};
+        SceneLoadOptions o = {.scale = 1.0, .overrides = &ov, .n_overrides = 1};
         mpm_clear_error();
         int st = scene_load("drop", &o, &s);
         const char *msg = mpm_last_error();
@@ -62,20 +62,20 @@ int main(void)
     }
     /* "transfer" switches on any scene, apic_ratio (bar3 has one) notwithstanding; the default alpha is 0.95 */
     SceneOverride sw[] = {{"transfer", "pic_flip"}};
-    SceneLoadOptions o2 = {4.0, sw, 1, NULL};
+    SceneLoadOptions o2 = {.scale = 4.0, .overrides = sw, .n_overrides = 1};
     mpm_clear_error();
     int st = scene_load("bar3", &o2, &s);
     CHECK(st == 0 && s.transfer == TRANSFER_PIC_FLIP && s.flip_alpha == 0.95, "bar3 with pic_flip: %s",
           mpm_last_error());
     if (!st) scene_free(&s);
     SceneOverride back[] = {{"transfer", "apic"}};
-    SceneLoadOptions o3 = {4.0, back, 1, NULL};
+    SceneLoadOptions o3 = {.scale = 4.0, .overrides = back, .n_overrides = 1};
     mpm_clear_error();
     st = scene_load("snowball-drop", &o3, &s);
     CHECK(st == 0 && s.transfer == TRANSFER_APIC, "snowball-drop with apic: %s", mpm_last_error());
     if (!st) scene_free(&s);
     SceneOverride alpha[] = {{"transfer.alpha", "0.5"}};
-    SceneLoadOptions o4 = {4.0, alpha, 1, NULL};
+    SceneLoadOptions o4 = {.scale = 4.0, .overrides = alpha, .n_overrides = 1};
     mpm_clear_error();
     st = scene_load("snowball-drop", &o4, &s);
     CHECK(st == 0 && s.transfer == TRANSFER_PIC_FLIP && s.flip_alpha == 0.5, "transfer.alpha=0.5: %s",

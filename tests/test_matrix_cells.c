@@ -27,6 +27,7 @@
 #include "experiments/matrix_csv.h"
 #include "experiments/matrix_measure.h"
 #include "experiments/matrix_results.h"
+#include "experiments/paths.h"
 #include "tests/testutil.h"
 
 static char g_dir[256];
@@ -204,7 +205,7 @@ static void test_cells_file(void)
 {
     char dir[320], path[400];
     snprintf(dir, sizeof dir, "%s/res", g_dir);
-    CHECK(matrix_mkdir_p(dir) == MPM_OK, "mkdir");
+    CHECK(paths_mkdir_p(dir) == MPM_OK, "mkdir");
     snprintf(path, sizeof path, "%s/cells.csv", dir);
     FILE *f = fopen(path, "w");
     if (!f) return;

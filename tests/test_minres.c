@@ -167,7 +167,10 @@ int main(void)
     for (int i = 0; i < N; ++i) d[i] = fabs(A.a[i * N + i]) + 1.0 + i;
     InvApprox *M = diagonal_preconditioner(d);
     st = minres_solve(&op, M, NULL, b, x, &o, &w, &res);
-    CHECK(st == MPM_OK && rel_err(x, xs) < 1e-9 && res.iters <= N + 2,
+    /* N iterations in exact arithmetic; finite-precision Lanczos loses
+       orthogonality and needs a few more (19 for this system), while a broken
+       recurrence runs to the cap of 1000 */
+    CHECK(st == MPM_OK && rel_err(x, xs) < 1e-9 && res.iters <= 2 * N,
           "preconditioned: st %d, relative error %.3e, %d iterations", st, rel_err(x, xs), res.iters);
     dense_apply(&A, x, r);
     double rr = 0.0;

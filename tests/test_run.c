@@ -46,7 +46,7 @@ static OuterMethodOps g_mock_ops = {"mock", "breaks down", 0, mock_create, mock_
 static void breakdown_policy(void)
 {
     Scene sc;
-    SceneLoadOptions lo = {3.0, NULL, 0, NULL};
+    SceneLoadOptions lo = {.scale = 3.0};
     int st = scene_load("drop", &lo, &sc);
     CHECK(st == MPM_OK, "scene: %s", mpm_last_error());
     if (st) return;

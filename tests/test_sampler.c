@@ -218,8 +218,8 @@ static void test_speed(const PoissonTile *t)
     double t0 = omp_get_wtime();
     sampler_sample(box, SAMPLING_POISSON, 0.01, 10, 1, t, &p);
     double t1 = omp_get_wtime();
+    /* timing is printed for information only (no wall-time assertion: benchmarks measure speed) */
     printf("poisson cut: %zu samples in %.3f s (%d threads)\n", p.n, t1 - t0, omp_get_max_threads());
-    CHECK(t1 - t0 < 10.0, "fast enough");
     CHECK(fabs(p.n / (SAMPLER_DENSITY * 10 * 125000) - 1) < 0.05, "density of the large cut");
     sample_points_free(&p);
     shape_free(box);

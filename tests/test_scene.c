@@ -1,7 +1,9 @@
-/* Scenes: every built-in loads, particle counts, --set overrides, --scale,
- * initial F, and bad input (each a one-line MPM_EINPUT naming the field). */
+/* The scene loader's behaviour on scene text written by the test itself
+ * (fields kept, defaults, particle counts, masses, --set, --scale, initial
+ * F), the listing of built-ins, and bad input (each a one-line MPM_EINPUT
+ * naming the field). Whether every built-in scene loads and runs is
+ * test_scenes_suite's. */
 #include <math.h>
-#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,7 +14,9 @@
 #include "core/scene.h"
 #include "tests/testutil.h"
 
-static double now(void) { return omp_get_wtime(); }
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
 
 typedef struct {
     char names[64][64];
@@ -47,123 +51,6 @@ static void test_list(void)
         if (k && strcmp(l.names[k - 1], l.names[k]) >= 0) sorted = 0;
     }
     CHECK(has_bar3 && has_drop && has_sb && sorted, "built-ins listed and sorted (%d)", l.n);
-}
-
-static void test_drop(void)
-{
-    Scene s;
-    mpm_clear_error();
-    double t0 = now();
-    int st = scene_load("drop", NULL, &s);
-    CHECK(st == 0, "drop: %s", mpm_last_error());
-    if (st) return;
-    printf("drop: %zu particles (%.3f s)\n", s.particles.n, now() - t0);
-    double expect = SAMPLER_DENSITY * 8 * 0.008 / (0.02 * 0.02 * 0.02);
-    CHECK(fabs(s.particles.n / expect - 1) < 0.05, "drop count %zu vs %g", s.particles.n, expect);
-    CHECK(fabs(total_mass(&s) - 8.0) < 1e-9, "mass = density * volume: %g", total_mass(&s));
-    CHECK(s.n_colliders == 7 && strcmp(s.colliders[0].name, "ground") == 0 &&
-              strcmp(s.colliders[1].name, "wall_x_min") == 0,
-          "ground + 6 walls");
-    CHECK(s.frames == 24 && s.fps == 24 && fabs(s.max_dt - 1.0 / 24) < 1e-15 && s.cfl == 0.6 && s.apic_ratio == 1,
-          "defaults");
-    CHECK(s.gravity[1] == -9.8 && s.n_materials == 1 && s.materials[0].mu > 0, "gravity/material");
-    double x[3] = {0.5, 0.05, 0.5};
-    CHECK(collider_phi(&s.colliders[0], 0, x, NULL) < 0, "ground solid below 0.1");
-    /* walls: solid outside the domain, open inside */
-    double out[3] = {-0.01, 0.5, 0.5}, in[3] = {0.01, 0.5, 0.5};
-    CHECK(collider_phi(&s.colliders[1], 0, out, NULL) < 0 && collider_phi(&s.colliders[1], 0, in, NULL) > 0,
-          "x-min wall");
-    int inside = 1;
-    for (size_t k = 0; k < s.particles.n; ++k)
-        for (int d = 0; d < 3; ++d) {
-            double v = s.particles.x[3 * k + d];
-            double lo = d == 1 ? 0.2 : 0.4, hi = d == 1 ? 0.4 : 0.6;
-            if (v < lo || v > hi) inside = 0;
-        }
-    CHECK(inside, "particles in the box");
-    CHECK(s.particles.F[0] == 1 && s.particles.F[1] == 0 && s.particles.v[1] == 0, "F = I, v = 0");
-    scene_free(&s);
-}
-
-static void test_bar3(void)
-{
-    Scene s;
-    mpm_clear_error();
-    double t0 = now();
-    int st = scene_load("bar3", NULL, &s);
-    CHECK(st == 0, "bar3: %s", mpm_last_error());
-    if (st) return;
-    double t1 = now();
-    size_t n1 = s.particles.n;
-    double expect = SAMPLER_DENSITY * 12 * (0.12 * 0.12 * 0.9) / pow(0.0075, 3);
-    printf("bar3: %zu particles (expected ~%.0f), load %.3f s\n", n1, expect, t1 - t0);
-    CHECK(fabs(n1 / expect - 1) < 0.05, "bar3 count %zu vs %g", n1, expect);
-    CHECK(s.n_materials == 2 && strcmp(s.materials[1].name, "middle") == 0 && s.materials[1].E == 1e9 &&
-              s.materials[0].E == 1e5,
-          "materials");
-    CHECK(s.n_objects == 3 && s.object_offsets[3] == n1, "objects");
-    int mats_ok = 1;
-    for (size_t k = s.object_offsets[1]; k < s.object_offsets[2]; ++k)
-        if (s.particles.mat[k] != 1 || s.particles.x[3 * k + 1] < 3.1 || s.particles.x[3 * k + 1] > 3.4) mats_ok = 0;
-    CHECK(mats_ok, "middle segment particles");
-    CHECK(s.n_colliders == 8 && strcmp(s.colliders[1].name, "top_cap") == 0, "2 caps + 6 walls");
-    CHECK(s.frames == 48 && s.fps == 48 && fabs(s.max_dt - 1.0 / 48) < 1e-15 && s.gravity[1] == 0, "timing");
-    CHECK(fabs(total_mass(&s) - 2000 * 0.01296) < 1e-9, "mass %g", total_mass(&s));
-    scene_free(&s);
-
-    /* --set: the middle stiffness (the Fig. 20 sweep), and a nested array path */
-    SceneOverride ov[3] = {{"materials.middle.E", "1e7"},
-                           {"colliders.1.motion.0.angular_velocity_deg.1", "180"},
-                           {"materials.ends.E", "1e9"}};
-    SceneLoadOptions opt = {.scale = 2.0, .overrides = ov, .n_overrides = 3};
-    mpm_clear_error();
-    st = scene_load("bar3", &opt, &s);
-    CHECK(st == 0, "bar3 --set --scale 2: %s", mpm_last_error());
-    if (st) return;
-    CHECK(s.materials[1].E == 1e7 && s.materials[0].E == 1e9, "--set E took effect");
-    double R[9], b[3];
-    collider_pose(&s.colliders[1], 1.0, R, b);
-    CHECK(fabs(R[0] + 1) < 1e-12, "--set angular velocity: 180 deg after 1 s");
-    CHECK(fabs(s.dx - 0.015) < 1e-15, "scaled dx");
-    size_t n2 = s.particles.n;
-    printf("bar3 --scale 2: %zu particles (ratio %.3f)\n", n2, (double)n1 / n2);
-    CHECK(fabs((double)n1 / n2 / 8.0 - 1) < 0.05, "scale 2 gives ~1/8 particles: %zu vs %zu", n2, n1);
-    CHECK(fabs(total_mass(&s) - 2000 * 0.01296) < 1e-9, "mass independent of scale");
-    scene_free(&s);
-}
-
-static void test_stretched_box(void)
-{
-    Scene s, s2;
-    mpm_clear_error();
-    /* scale 2 (dx 0.02) and the per-particle variant of the initial F */
-    SceneOverride per = {"objects.0.initial_F.per_particle", "true"};
-    SceneLoadOptions lo = {2.0, &per, 1, NULL};
-    int st = scene_load("stretched-box", &lo, &s);
-    CHECK(st == 0, "stretched-box: %s", mpm_last_error());
-    if (st) return;
-    printf("stretched-box: %zu particles\n", s.particles.n);
-    double expect = SAMPLER_DENSITY * 8 * 0.027 / (0.02 * 0.02 * 0.02);
-    CHECK(fabs(s.particles.n / expect - 1) < 0.05, "count");
-    int ok = 1, distinct = 0;
-    double mn = 9, mx = 0;
-    for (size_t k = 0; k < s.particles.n; ++k) {
-        const double *F = s.particles.F + 9 * k;
-        for (int e = 0; e < 9; ++e)
-            if (e % 4 != 0 && F[e] != 0) ok = 0;
-        for (int d = 0; d < 3; ++d) mn = fmin(mn, F[4 * d]), mx = fmax(mx, F[4 * d]);
-        if (k && F[0] != s.particles.F[9 * (k - 1)]) ++distinct;
-    }
-    CHECK(ok && mn >= 0.7 && mx <= 1.3 && mn < 0.72 && mx > 1.28, "diagonal F in [0.7, 1.3]: %g %g", mn, mx);
-    CHECK(distinct > (int)s.particles.n / 2, "per-particle F");
-    CHECK(s.frames == 1 && s.gravity[1] == 0, "one frame, no gravity");
-    st = scene_load("stretched-box", &lo, &s2);
-    CHECK(st == 0 && s2.particles.n == s.particles.n &&
-              memcmp(s2.particles.F, s.particles.F, 9 * s.particles.n * sizeof(double)) == 0 &&
-              memcmp(s2.particles.x, s.particles.x, 3 * s.particles.n * sizeof(double)) == 0,
-          "deterministic");
-    scene_free(&s2);
-    scene_free(&s);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -203,6 +90,148 @@ static const char *write_variant(const char *from, const char *to, char *path, s
     }
     fclose(f);
     return path;
+}
+
+/* Loads a variant of k_base (see write_variant); 0 on success. */
+static int load_variant(const char *from, const char *to, const SceneLoadOptions *opt, Scene *s)
+{
+    char path[256];
+    memset(s, 0, sizeof *s);
+    if (!write_variant(from, to, path, sizeof path)) return -1;
+    mpm_clear_error();
+    int st = scene_load(path, opt, s);
+    remove(path);
+    return st;
+}
+
+static double object_mass(const Scene *s, int obj)
+{
+    double m = 0;
+    for (size_t k = s->object_offsets[obj]; k < s->object_offsets[obj + 1]; ++k) m += s->particles.mass[k];
+    return m;
+}
+
+/* What the loader does with the fields of a file (the test's own text):
+ * given values kept, omitted optional ones defaulted, particle count from
+ * the sampling density, mass = density x volume, per-object material. */
+static void test_fields_and_defaults(void)
+{
+    Scene s;
+    int st = load_variant(NULL, NULL, NULL, &s);
+    CHECK(st == 0, "base: %s", mpm_last_error());
+    if (st) return;
+    CHECK(s.dx == 0.05 && s.fps == 24 && s.frames == 2 && s.gravity[1] == -9.8, "given fields kept");
+    CHECK(s.cfl == 0.6 && s.max_dt == 1.0 / 24 && s.min_dt == 1e-6 && s.apic_ratio == 1 &&
+              s.cfl_rule == CFL_RULE_PAPER && !s.domain_walls && s.n_colliders == 0 && s.seed == 1,
+          "defaults: cfl %g max_dt %g min_dt %g apic %g rule %d walls %d", s.cfl, s.max_dt, s.min_dt, s.apic_ratio,
+          (int)s.cfl_rule, s.domain_walls);
+    double expect = SAMPLER_DENSITY * 8 * 0.008 / (0.05 * 0.05 * 0.05);
+    CHECK(fabs(s.particles.n / expect - 1) < 0.1, "count %zu vs %g", s.particles.n, expect);
+    CHECK(fabs(total_mass(&s) - 1000 * 0.008) < 1e-12, "mass = density x volume: %g", total_mass(&s));
+    int in_box = 1;
+    for (size_t k = 0; k < s.particles.n; ++k)
+        for (int d = 0; d < 3; ++d) in_box &= s.particles.x[3 * k + d] >= 0.4 && s.particles.x[3 * k + d] <= 0.6;
+    CHECK(in_box, "particles inside their box");
+    CHECK(s.particles.F[0] == 1 && s.particles.F[1] == 0 && s.particles.v[1] == 0, "F = I, v = 0");
+    scene_free(&s);
+
+    /* given optional fields, two objects of two materials, walls */
+    st = load_variant("\"frames\": 2,",
+                      "\"frames\": 2, \"cfl\": 0.3, \"max_dt\": 0.01, \"min_dt\": 1e-5, \"apic_ratio\": 0, "
+                      "\"cfl_rule\": \"reference\", \"domain_walls\": true, \"seed\": 7,",
+                      NULL, &s);
+    CHECK(st == 0 && s.cfl == 0.3 && s.max_dt == 0.01 && s.min_dt == 1e-5 && s.apic_ratio == 0 &&
+              s.cfl_rule == CFL_RULE_REFERENCE && s.domain_walls && s.seed == 7,
+          "optional fields: %s", mpm_last_error());
+    if (!st) {
+        CHECK(s.n_colliders == 6 && strcmp(s.colliders[0].name, "wall_x_min") == 0, "six walls");
+        double out[3] = {-0.01, 0.5, 0.5}, in[3] = {0.01, 0.5, 0.5};
+        CHECK(collider_phi(&s.colliders[0], 0, out, NULL) < 0 && collider_phi(&s.colliders[0], 0, in, NULL) > 0,
+              "x-min wall solid outside the domain only");
+    }
+    scene_free(&s);
+    st = load_variant("\"materials\": {\"soft\": {\"E\": 1e5, \"nu\": 0.3, \"density\": 1000}},",
+                      "\"materials\": {\"soft\": {\"E\": 1e5, \"nu\": 0.3, \"density\": 1000},"
+                      " \"hard\": {\"E\": 1e7, \"nu\": 0.2, \"density\": 3000}},"
+                      " \"colliders\": [{\"name\": \"floor\", \"shape\": {\"type\": \"half_space\", \"point\": [0, 0.1, 0],"
+                      " \"normal\": [0, 1, 0]}}],",
+                      NULL, &s);
+    CHECK(st == 0 && s.n_materials == 2 && strcmp(s.materials[1].name, "hard") == 0 && s.materials[1].density == 3000 &&
+              s.materials[1].mu > s.materials[0].mu && s.n_colliders == 1 && strcmp(s.colliders[0].name, "floor") == 0,
+          "materials in declaration order, named collider: %s", mpm_last_error());
+    scene_free(&s);
+    st = load_variant("\"shape\": {\"type\": \"box\", \"min\": [0.4, 0.4, 0.4], \"max\": [0.6, 0.6, 0.6]}}]",
+                      "\"shape\": {\"type\": \"box\", \"min\": [0.4, 0.4, 0.4], \"max\": [0.6, 0.6, 0.6]}},"
+                      " {\"material\": \"soft\", \"ppc\": 27, \"sampling\": \"lattice\","
+                      "  \"shape\": {\"type\": \"sphere\", \"center\": [0.3, 0.8, 0.3], \"radius\": 0.1}}]",
+                      NULL, &s);
+    CHECK(st == 0 && s.n_objects == 2, "two objects: %s", mpm_last_error());
+    if (!st) {
+        double sphere = 4.0 / 3.0 * M_PI * 1e-3;
+        CHECK(fabs(object_mass(&s, 0) - 8.0) < 1e-12 && fabs(object_mass(&s, 1) - 1000 * sphere) < 1e-12,
+              "per-object mass = density x own volume: %g %g", object_mass(&s, 0), object_mass(&s, 1));
+        size_t n1 = s.object_offsets[2] - s.object_offsets[1];
+        double want = 27 * sphere / (0.05 * 0.05 * 0.05);
+        CHECK(fabs(n1 / want - 1) < 0.15, "lattice count %zu vs %g (27 per cell)", n1, want);
+    }
+    scene_free(&s);
+}
+
+/* --scale multiplies dx, divides the count by scale^3, keeps the mass;
+ * --set changes a field before validation. */
+static void test_scale_and_set(void)
+{
+    Scene a, b;
+    int st = load_variant(NULL, NULL, NULL, &a);
+    SceneOverride ov[2] = {{"materials.soft.E", "3e6"}, {"objects.0.velocity", "[0, 1, 0]"}};
+    SceneLoadOptions opt = {.scale = 0.5, .overrides = ov, .n_overrides = 2};
+    if (!st) st = load_variant(NULL, NULL, &opt, &b);
+    CHECK(st == 0, "scale/set: %s", mpm_last_error());
+    if (st) {
+        scene_free(&a);
+        return;
+    }
+    CHECK(b.dx == 0.025, "dx times scale: %g", b.dx);
+    CHECK(fabs((double)b.particles.n / a.particles.n / 8.0 - 1) < 0.1, "scale 0.5: 8x the particles (%zu vs %zu)",
+          b.particles.n, a.particles.n);
+    CHECK(fabs(total_mass(&b) - total_mass(&a)) < 1e-12, "mass independent of scale");
+    CHECK(b.materials[0].E == 3e6 && a.materials[0].E == 1e5, "--set E");
+    CHECK(b.particles.v[1] == 1 && b.particles.v[3 * (b.particles.n - 1) + 1] == 1, "--set velocity");
+    scene_free(&a);
+    scene_free(&b);
+}
+
+/* initial_F: diagonal, within [min, max], per particle or per object,
+ * deterministic from the seed. */
+static void test_initial_F(void)
+{
+    const char *per = "\"ppc\": 8, \"initial_F\": {\"type\": \"random_diagonal\", \"min\": 0.7, \"max\": 1.3}";
+    const char *one = "\"ppc\": 8, \"initial_F\": {\"type\": \"random_diagonal\", \"min\": 0.7, \"max\": 1.3, "
+                      "\"per_particle\": false}";
+    Scene s, s2, s3;
+    int st = load_variant("\"ppc\": 8", per, NULL, &s);
+    if (!st) st = load_variant("\"ppc\": 8", per, NULL, &s2);
+    if (!st) st = load_variant("\"ppc\": 8", one, NULL, &s3);
+    CHECK(st == 0, "initial_F: %s", mpm_last_error());
+    if (st) return;
+    int diag = 1, distinct = 0, same = 1;
+    double mn = 9, mx = 0;
+    for (size_t k = 0; k < s.particles.n; ++k) {
+        const double *F = s.particles.F + 9 * k;
+        for (int e = 0; e < 9; ++e)
+            if (e % 4 != 0 && F[e] != 0) diag = 0;
+        for (int d = 0; d < 3; ++d) mn = fmin(mn, F[4 * d]), mx = fmax(mx, F[4 * d]);
+        if (k && F[0] != s.particles.F[9 * (k - 1)]) ++distinct;
+        if (memcmp(s3.particles.F + 9 * k, s3.particles.F, 9 * sizeof(double))) same = 0;
+    }
+    CHECK(diag && mn >= 0.7 && mx <= 1.3 && mn < 0.75 && mx > 1.25, "diagonal F in [0.7, 1.3]: %g %g", mn, mx);
+    CHECK(distinct > (int)s.particles.n / 2, "per particle: %d distinct of %zu", distinct, s.particles.n);
+    CHECK(same && s3.particles.F[0] != 1.0, "per object: one F for all");
+    CHECK(s2.particles.n == s.particles.n && memcmp(s2.particles.F, s.particles.F, 9 * s.particles.n * sizeof(double)) == 0,
+          "deterministic");
+    scene_free(&s);
+    scene_free(&s2);
+    scene_free(&s3);
 }
 
 static void expect_bad(const char *what, const char *from, const char *to, const SceneLoadOptions *opt,
@@ -278,6 +307,33 @@ static void test_bad_input(void)
                "\"point\": [0, 0, 0], \"normal\": [0, 0, 0]}}],",
                NULL, "colliders.0.shape.normal", NULL);
 
+    /* time steps against the frame length (issue 12 item 4), messages naming the real field (item 10) */
+    expect_bad("fps tiny", "\"fps\": 24", "\"fps\": 1e-310", NULL, "fps: expected a frame rate", "1e-310");
+    expect_bad("fps huge", "\"fps\": 24", "\"fps\": 1e9", NULL, "fps: expected at most 1/min_dt", NULL);
+    expect_bad("max_dt below floor", "\"fps\": 24,", "\"fps\": 24, \"max_dt\": 1e-12,", NULL,
+               "max_dt: expected at least min_dt", "1e-12");
+    expect_bad("min_dt above frame", "\"fps\": 24,", "\"fps\": 24, \"min_dt\": 0.5,", NULL,
+               "min_dt: expected at most the frame length", NULL);
+    expect_bad("min_dt tiny", "\"fps\": 24,", "\"fps\": 24, \"min_dt\": 1e-300,", NULL,
+               "min_dt: expected at least the frame length", NULL);
+    expect_bad("bad cfl_rule", "\"fps\": 24,", "\"fps\": 24, \"cfl_rule\": \"hot\",", NULL, "cfl_rule",
+               "\"hot\"");
+    expect_bad("dx above domain", "\"dx\": 0.05", "\"dx\": 1e308", NULL, "dx: expected at most the domain", NULL);
+    expect_bad("dx too fine", "\"dx\": 0.05", "\"dx\": 1e-300", NULL, "dx: expected at least", NULL);
+    expect_bad("density 1e-300", "\"density\": 1000", "\"density\": 1e-300", NULL, "materials.soft.density",
+               "1e-300");
+    expect_bad("collider spin 1e308", "\"gravity\": [0, -9.8, 0],",
+               "\"gravity\": [0, -9.8, 0], \"colliders\": [{\"shape\": {\"type\": \"sphere\", \"center\": [0.5, "
+               "0.9, 0.5], \"radius\": 0.05}, \"motion\": [{\"angular_velocity_deg\": [0, 1e308, 0]}]}],",
+               NULL, "colliders.0.motion.0", "non-finite speed");
+    /* particle budget (item 5): refused before sampling, naming the object */
+    expect_bad("ppc over budget", "\"ppc\": 8", "\"ppc\": 1e10", NULL, "objects.0: ppc 1e+10",
+               "particle budget");
+    SceneLoadOptions small = {.max_particles = 100};
+    expect_bad("--max-particles", NULL, NULL, &small, "objects.0: ppc 8", "particle budget 100");
+    SceneLoadOptions fine = {.scale = 0.01};
+    expect_bad("--scale 0.01", NULL, NULL, &fine, "dx times --scale 0.01", "particle budget");
+
     SceneOverride o1[1] = {{"materials.sof.E", "1e9"}};
     SceneLoadOptions opt1 = {.overrides = o1, .n_overrides = 1};
     expect_bad("--set missing path", NULL, NULL, &opt1, "materials.sof", "does not exist");
@@ -315,16 +371,61 @@ static void test_bad_input(void)
     printf("  %-22s -> %s\n", "unknown built-in", mpm_last_error());
     mpm_clear_error();
     CHECK(scene_load("/tmp/definitely/missing.json", NULL, &s) == MPM_EINPUT &&
-              strstr(mpm_last_error(), "missing.json"),
-          "missing file");
+              strstr(mpm_last_error(), "missing.json") && strstr(mpm_last_error(), "not found"),
+          "missing file: %s", mpm_last_error());
+    /* a directory, a device and an empty file are not "not found" (item 10) */
+    const char *dir = "/tmp", *dev = "/dev/null";
+    mpm_clear_error();
+    CHECK(scene_load(dir, NULL, &s) == MPM_EINPUT && strstr(mpm_last_error(), "is a directory"), "directory: %s",
+          mpm_last_error());
+    mpm_clear_error();
+    CHECK(scene_load(dev, NULL, &s) == MPM_EINPUT && strstr(mpm_last_error(), "not a regular file"), "device: %s",
+          mpm_last_error());
+    snprintf(path, sizeof path, "/tmp/mpm_test_scene_%d_empty.json", (int)getpid());
+    FILE *f = fopen(path, "w");
+    if (f) fclose(f);
+    mpm_clear_error();
+    CHECK(scene_load(path, NULL, &s) == MPM_EINPUT && strstr(mpm_last_error(), "empty file"), "empty: %s",
+          mpm_last_error());
+    remove(path);
+}
+
+/* A mesh loader failure reaches the user as "scene: field: mesh file:line:
+ * value": the loader's own message, prefixed on the way up by
+ * mpm_error_context (no clear-and-reissue, issue 12 item 12). */
+static void test_error_context(void)
+{
+    char obj[256];
+    snprintf(obj, sizeof obj, "/tmp/mpm_test_scene_%d_bad.obj", (int)getpid());
+    FILE *f = fopen(obj, "w");
+    if (!f) return;
+    fprintf(f, "v 0 0 0\nv 1 0 0\nv 1e308 0.2 0.4\nf 1 2 3\n");
+    fclose(f);
+    char shape[400];
+    snprintf(shape, sizeof shape, "\"shape\": {\"type\": \"mesh\", \"file\": \"%s\"}}]", obj);
+    char path[256];
+    write_variant("\"shape\": {\"type\": \"box\", \"min\": [0.4, 0.4, 0.4], \"max\": [0.6, 0.6, 0.6]}}]", shape, path,
+                  sizeof path);
+    Scene s;
+    mpm_clear_error();
+    int st = scene_load(path, NULL, &s);
+    char want[700];
+    snprintf(want, sizeof want, "%s: objects.0.shape.file: %s:3: vertex coordinate '1e308' is out of range", path, obj);
+    CHECK(st == MPM_EINPUT, "status %d", st);
+    CHECK(strncmp(mpm_last_error(), want, strlen(want)) == 0, "context chain:\n  got  %s\n  want %s...",
+          mpm_last_error(), want);
+    printf("  %-22s -> %s\n", "mesh vertex 1e308", mpm_last_error());
+    remove(path);
+    remove(obj);
 }
 
 int main(void)
 {
     test_list();
-    test_drop();
-    test_stretched_box();
-    test_bar3();
+    test_fields_and_defaults();
+    test_scale_and_set();
+    test_initial_F();
     test_bad_input();
+    test_error_context();
     return test_summary("test_scene");
 }

@@ -14,7 +14,7 @@
 static int first_step(const char *spec, SolveStats *out)
 {
     Scene sc;
-    SceneLoadOptions lo = {1.4, NULL, 0, NULL};
+    SceneLoadOptions lo = {.scale = 1.4};
     int st = scene_load("stretched-box", &lo, &sc);
     if (st) return st;
     Simulation sim;

@@ -24,6 +24,7 @@ double rel_diff(double a, double b, double floor_);
 /* Deterministic uniform in [lo, hi) (splitmix64 stream owned by the caller). */
 double test_uniform(unsigned long long *state, double lo, double hi);
 
+/* Prints the counts; non-zero if a check failed or if no check ran at all. */
 int test_summary(const char *name);
 
 struct Scene;
