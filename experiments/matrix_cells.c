@@ -375,7 +375,7 @@ static int prepend_references(MatrixCells *out, MatrixCell *refs, int n_refs)
     MatrixCell *all = calloc((size_t)(out->n + n_refs), sizeof *all);
     if (!all) return mpm_error(MPM_EINTERNAL, "out of memory (%d cells)", out->n + n_refs);
     memcpy(all, refs, sizeof *all * (size_t)n_refs);
-    memcpy(all + n_refs, out->cells, sizeof *all * (size_t)out->n);
+    if (out->n) memcpy(all + n_refs, out->cells, sizeof *all * (size_t)out->n);
     free(out->cells);
     out->cells = all;
     out->n += n_refs;

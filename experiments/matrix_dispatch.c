@@ -129,7 +129,7 @@ static int outbox_send(Outbox *o, const void *data, int bytes, int dest, int tag
     }
     void *b = malloc(bytes > 0 ? (size_t)bytes : 1);
     if (!b) return mpm_error(MPM_EINTERNAL, "out of memory (MPI message)");
-    memcpy(b, data, (size_t)bytes);
+    if (bytes > 0) memcpy(b, data, (size_t)bytes); /* a zero-length message may come with data == NULL */
     o->buf[o->n] = b;
     if (MPI_Isend(b, bytes, MPI_BYTE, dest, tag, MPI_COMM_WORLD, &o->req[o->n]) != MPI_SUCCESS) {
         free(b);
