@@ -103,7 +103,7 @@ EOF
 check "plain matrix: the id it always had" grep -q "^bd1ff00e495e  todo  drop/hot" "$tmp/plain.txt"
 
 if command -v mpirun >/dev/null; then
-  timeout 180 mpirun --oversubscribe --allow-run-as-root -np 2 "$bin" matrix run "$tmp/m.json" --out "$tmp/mpi" \
+  mpirun_ranks -np 2 "$bin" matrix run "$tmp/m.json" --out "$tmp/mpi" \
     >"$tmp/mpi.txt" 2>"$tmp/mpi.err"
   check "mpirun -np 2: exit 0 ($(head -c 300 "$tmp/mpi.err"))" test $? -eq 0
   check "mpirun: all 9 cells ok" test "$(col "$tmp/mpi/cells.csv" status | grep -c ok)" -eq 9

@@ -17,7 +17,7 @@ cat >"$tmp/m.json" <<'EOF'
 EOF
 "$bin" matrix run "$tmp/m.json" --out "$tmp/serial" >"$tmp/serial.txt" 2>&1
 check "serial run exit 0" test $? -eq 0
-timeout 180 mpirun --oversubscribe --allow-run-as-root -np 2 "$bin" matrix run "$tmp/m.json" --out "$tmp/mpi" \
+mpirun_ranks -np 2 "$bin" matrix run "$tmp/m.json" --out "$tmp/mpi" \
   >"$tmp/mpi.txt" 2>"$tmp/mpi.err"
 rc=$?
 check "mpirun -np 2 exit 0 (got $rc: $(head -c 300 "$tmp/mpi.err"))" test "$rc" -eq 0
