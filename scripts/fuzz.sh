@@ -3,7 +3,7 @@
 #   scripts/fuzz.sh TARGET SECONDS      TARGET: scene | obj | set | all
 # Builds $MPM_FUZZ_BUILD (default build-fuzz) with clang (-DMPM_FUZZ=ON,
 # configured once), then runs fuzz/fuzz_TARGET there for SECONDS on one core
-# (nice), starting from the seed corpus tests/fuzz/corpus/TARGET (plus what
+# (nice; with `all`, one target per core at a time), starting from the seed corpus tests/fuzz/corpus/TARGET (plus what
 # earlier runs found, in BUILD/corpus/TARGET) with tests/fuzz/TARGET.dict.
 # A crash, leak, sanitizer report or timeout exits non-zero and leaves the
 # input in BUILD/crashes/TARGET/: copy it to tests/fuzz/regressions/TARGET/
@@ -37,11 +37,11 @@ done
 export OMP_NUM_THREADS=1 OMP_WAIT_POLICY=passive
 export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:abort_on_error=1:allocator_may_return_null=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
-status=0
-for t in "${targets[@]}"; do
-  corpus=$build/corpus/$t crashes=$build/crashes/$t log=$build/fuzz-$t.log
+# one target per core at a time (libFuzzer itself runs on one core)
+fuzz_one() {
+  local t=$1 corpus=$build/corpus/$1 crashes=$build/crashes/$1 log=$build/fuzz-$1.log rc
   mkdir -p "$corpus" "$crashes"
-  dict=()
+  local dict=()
   [ -f "tests/fuzz/$t.dict" ] && dict=(-dict="tests/fuzz/$t.dict")
   set +e
   nice -n 10 "$build/fuzz/fuzz_$t" "$corpus" "tests/fuzz/corpus/$t" "${dict[@]}" \
@@ -49,13 +49,24 @@ for t in "${targets[@]}"; do
     -artifact_prefix="$crashes/" -print_final_stats=1 >"$log" 2>&1
   rc=$?
   set -e
+  local execs ncrash nslow
   execs=$(grep -E "^stat::number_of_executed_units" "$log" | tail -1 | awk '{print $2}')
   ncrash=$(find "$crashes" -type f \( -name 'crash-*' -o -name 'leak-*' -o -name 'timeout-*' -o -name 'oom-*' \) | wc -l)
   nslow=$(find "$crashes" -type f -name 'slow-unit-*' | wc -l)
   echo "fuzz $t: ${execs:-0} executions in $seconds s, exit $rc, $ncrash crash/leak/timeout/oom inputs ($nslow slow) in $crashes (log $log)"
   if [ "$rc" -ne 0 ]; then
     grep -m5 -E "ERROR|runtime error|SUMMARY|without a one-line|outside|abort" "$log" >&2 || tail -20 "$log" >&2
-    status=1
+    return 1
+  fi
+}
+status=0 cores=$(nproc) pids=()
+for t in "${targets[@]}"; do
+  fuzz_one "$t" &
+  pids+=($!)
+  if [ "${#pids[@]}" -ge "$cores" ]; then
+    wait "${pids[0]}" || status=1
+    pids=("${pids[@]:1}")
   fi
 done
+for p in "${pids[@]}"; do wait "$p" || status=1; done
 exit $status
