@@ -28,6 +28,8 @@ command -v clang >/dev/null || { echo "fuzz.sh: needs clang (scripts/setup.sh in
 build=${MPM_FUZZ_BUILD:-build-fuzz}
 if [ ! -f "$build/CMakeCache.txt" ]; then
   CC=clang cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMPM_FUZZ=ON >/dev/null
+else
+  cmake -S . -B "$build" >/dev/null # picks up a harness added since (fuzz_*.c glob)
 fi
 for t in "${targets[@]}"; do
   nice -n 10 cmake --build "$build" -j"$(nproc)" --target "fuzz_$t" -- --no-print-directory >"$build/fuzz-build.log" 2>&1 ||
