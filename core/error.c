@@ -19,10 +19,20 @@ static Message g_team;
 
 static int in_worker(void) { return omp_in_parallel() && omp_get_thread_num() != 0; }
 
+/* A message is one line: control characters that came in with a quoted
+ * input value (a JSON key with an escaped newline, a tab in a file name)
+ * become '?'. */
+static void one_line(char *text)
+{
+    for (unsigned char *c = (unsigned char *)text; *c; ++c)
+        if (*c < 0x20 || *c == 0x7f) *c = '?';
+}
+
 static void record(Message *m, const char *fmt, va_list ap)
 {
     if (m->set) return; /* the first message of a failure is the most precise one */
     vsnprintf(m->text, sizeof m->text, fmt, ap);
+    one_line(m->text);
     m->set = 1;
 }
 
@@ -77,6 +87,7 @@ int mpm_error_context(int status, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(ctx, sizeof ctx, fmt, ap);
     va_end(ap);
+    one_line(ctx);
     if (in_worker()) {
 #pragma omp critical(mpm_error_team)
         prefix(&g_team, ctx);

@@ -49,6 +49,12 @@ static void test_errors(void)
     mpm_clear_error();
     mpm_error_context(MPM_EINPUT, "only context");
     CHECK(strcmp(mpm_last_error(), "only context") == 0, "context without a message: %s", mpm_last_error());
+    /* one line whatever the input held (fuzz_matrix: a JSON key with an escaped newline) */
+    mpm_clear_error();
+    mpm_error(MPM_EINPUT, "%s: unknown key", "ref\nere\tnce");
+    mpm_error_context(MPM_EINPUT, "%s", "m\r.json");
+    CHECK(strcmp(mpm_last_error(), "m?.json: ref?ere?nce: unknown key") == 0, "control characters replaced: %s",
+          mpm_last_error());
 
     /* another thread has its own message */
     mpm_clear_error();
