@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Coverage-guided fuzzing of one loader with libFuzzer + ASan + UBSan:
-#   scripts/fuzz.sh TARGET SECONDS      TARGET: scene | obj | set | all
+#   scripts/fuzz.sh TARGET SECONDS      TARGET: scene | obj | set | matrix | all
 # Builds $MPM_FUZZ_BUILD (default build-fuzz) with clang (-DMPM_FUZZ=ON,
 # configured once), then runs fuzz/fuzz_TARGET there for SECONDS on one core
 # (nice; with `all`, one target per core at a time), starting from the seed corpus tests/fuzz/corpus/TARGET (plus what
@@ -12,7 +12,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ $# -ne 2 ] || ! [[ "$2" =~ ^[0-9]+$ ]]; then
-  echo "usage: scripts/fuzz.sh scene|obj|set|all SECONDS" >&2
+  echo "usage: scripts/fuzz.sh scene|obj|set|matrix|all SECONDS" >&2
   exit 2
 fi
 what="$1" seconds="$2"

@@ -42,7 +42,7 @@ Accuracy (matrix_report_accuracy.py, beside this file): for cells run with
 error_ref or against a reference run, work-precision diagrams (wall time
 against the median per-step err_h and against the last frame's pos_rms, one
 PNG per case without eps, one line per solver), the time to reach err_h <=
-1e-4 / 1e-6 interpolated along eps, performance profiles at matched
+1e-2 / 1e-3 / 1e-4 / 1e-6 interpolated along eps, performance profiles at matched
 accuracy and wp.csv; with DIR/check.csv (matrix run --check) the case x
 solver pass/fail grid. Reference-run cells (cells.csv role "reference") are
 listed on their own, not as solvers of the cases.

@@ -12,7 +12,7 @@ whose frames.csv has pos_rms (run against a reference run):
     through its cells in eps order (cells that did not end ok are left out);
   * figures/wp_NN_CASE.png: wall time against median err_h and against the
     last frame's pos_rms, log-log, one line per solver;
-  * "time to reach err_h <= 1e-4 / 1e-6": along the solver's eps sequence
+  * "time to reach err_h <= 1e-2 / 1e-3 / 1e-4 / 1e-6": along the solver's eps sequence
     (loosest first), the first cell whose median err_h is at or below the
     target, the time interpolated linearly in log(err_h)-log(time) between
     it and the cell before it; "<= t" when the loosest eps already reaches
@@ -32,7 +32,10 @@ import math
 import os
 import statistics
 
-TARGETS = (1e-4, 1e-6)
+# 1e-2 and 1e-3 too: at the paper's eps = 1e-7 the measured median err_h is
+# 1e-4 ... 6e-2 (results/work-precision), so 1e-4 / 1e-6 alone leave most
+# solvers "not reached"
+TARGETS = (1e-2, 1e-3, 1e-4, 1e-6)
 
 
 def _num(s):

@@ -2,7 +2,7 @@
 # The report's accuracy sections (scripts/matrix_report_accuracy.py) on a
 # hand-made result directory with known answers: median err_h over the
 # timed steps only, the last frame's pos_rms, the time to reach err_h <=
-# 1e-4 / 1e-6 interpolated in log-log along eps (an exact hit, "<=" at the
+# 1e-2 / 1e-3 / 1e-4 / 1e-6 interpolated in log-log along eps (an exact hit, "<=" at the
 # loosest eps, "not reached" with the best error), the performance-profile
 # ratios at matched accuracy, wp.csv, reference runs kept out of the solver
 # tables, and the work-precision figure as an 800 x 500 PNG.
@@ -49,19 +49,21 @@ md="$d/report.md"
 check "work-precision section" grep -q "^## Work precision" "$md"
 check "median err_h per eps (timed steps only)" grep -q "^| A | 0.00100 | 1.00e-05 | 1.00e-07 |$" "$md"
 check "pos_rms at the last frame" grep -q "^| B | 0.00200 | 2.00e-04 | 2.00e-04 |$" "$md"
-check "A: interpolated 10^0.5 and 10^1.5 s" grep -q "^| A | 3.16 | 31.6 |$" "$md"
-check "B: reached at the loosest eps (<=), then an exact hit" grep -q "^| B | <= 2.00 | 4.00 |$" "$md"
-check "C: not reached, with the best error" grep -q "^| C | not reached (best 5.00e-04) | not reached (best 5.00e-04) |$" "$md"
+check "A: reached at the loosest eps, then interpolated 10^0.5 and 10^1.5 s" grep -q "^| A | <= 1.00 | <= 1.00 | 3.16 | 31.6 |$" "$md"
+check "B: reached at the loosest eps (<=), then an exact hit" grep -q "^| B | <= 2.00 | <= 2.00 | <= 2.00 | 4.00 |$" "$md"
+check "C: loosest, an exact hit at the next eps, then not reached with the best error" grep -q "^| C | <= 1.00 | 2.00 | not reached (best 5.00e-04) | not reached (best 5.00e-04) |$" "$md"
 check "the reference run is no solver of the cases" bash -c "! grep -q '^| pn-cholmod |' '$md'"
 check "the reference run listed apart" grep -q "^| ref0 | toy | pn-cholmod | 1e-12 | ok | 2 |" "$md"
 python3 - "$d/profile_accuracy.csv" >"$tmp/prof.txt" <<'PY'
 import csv, math, sys
 got = {(r["target_err_h"], r["solver"]): r["ratio"] for r in csv.DictReader(open(sys.argv[1]))}
-want = {("0.0001", "A"): 10 ** 0.5 / 2, ("0.0001", "B"): 1.0, ("0.0001", "C"): math.inf,
+want = {("0.01", "A"): 1.0, ("0.01", "B"): 2.0, ("0.01", "C"): 1.0,
+        ("0.001", "A"): 1.0, ("0.001", "B"): 2.0, ("0.001", "C"): 2.0,
+        ("0.0001", "A"): 10 ** 0.5 / 2, ("0.0001", "B"): 1.0, ("0.0001", "C"): math.inf,
         ("1e-06", "A"): 10 ** 1.5 / 4, ("1e-06", "B"): 1.0, ("1e-06", "C"): math.inf}
 bad = [k for k in want if k not in got or (math.isinf(want[k]) != (got[k] == "inf")) or
        (math.isfinite(want[k]) and abs(float(got[k]) - want[k]) > 1e-6)]
-print("ok" if not bad and len(got) == 6 else f"got {got}")
+print("ok" if not bad and len(got) == 12 else f"got {got}")
 PY
 check "profile ratios at matched accuracy ($(cat "$tmp/prof.txt"))" grep -qx ok "$tmp/prof.txt"
 check "the profile figure" test -s "$d/figures/profile_accuracy.png"
