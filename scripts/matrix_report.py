@@ -68,6 +68,14 @@ SMALL_COLUMNS = {"min_dt", "avg_dt", "max_residual"}  # written as %e in report.
 SOLVER_AXES = {"solver_setting"}
 
 
+def ranks_text(invocation):
+    """', mpirun: K ranks x J jobs' for a distributed run (provenance 'ranks' > 1), else ''."""
+    ranks, jobs = invocation.get("ranks", 1), invocation.get("jobs_per_rank", 1)
+    if not isinstance(ranks, int) or ranks <= 1:
+        return ""
+    return f", mpirun: {ranks} ranks x {jobs} job{'s' if jobs != 1 else ''}"
+
+
 def die(msg, code=2):
     print(f"matrix report: {msg}", file=sys.stderr)
     sys.exit(code)
@@ -510,7 +518,7 @@ def main(argv):
             p = inv[-1]
             b = p.get("build", {})
             md.append(f"Last run: {p.get('start_time', '?')} on {p.get('host', '?')} ({p.get('cpu_model', '?')}, "
-                      f"{p.get('cores_online', '?')} cores), build {b.get('git_commit', '?')[:12]}"
+                      f"{p.get('cores_online', '?')} cores{ranks_text(p)}), build {b.get('git_commit', '?')[:12]}"
                       f"{' (dirty)' if b.get('git_dirty') else ''}, {b.get('compiler', '?')} {b.get('flags', '')}.\n")
     except (OSError, ValueError):
         pass

@@ -43,4 +43,9 @@ print("ok")
 PY
 check "cells equal the serial run's ($(tail -1 "$tmp/cmp.txt"))" grep -qx ok "$tmp/cmp.txt"
 check "the AMG cells' children ran as singletons (no MPI complaint)" bash -c "! cat '$tmp'/mpi/cells/*/stderr.txt | grep -qi mpi"
+"$bin" matrix report "$tmp/mpi" >"$tmp/report.txt" 2>&1
+check "report of the distributed run exit 0" test $? -eq 0
+check "its report says it ran on 2 ranks" grep -q "mpirun: 2 ranks x 1 job)" "$tmp/mpi/report.md"
+"$bin" matrix report "$tmp/serial" >"$tmp/report-serial.txt" 2>&1
+check "the serial report says no mpirun" bash -c "! grep -q 'mpirun:' '$tmp/serial/report.md'"
 finish
