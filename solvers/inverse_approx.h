@@ -37,6 +37,10 @@ typedef struct {
     const LinearOp *op;        /* the BC-projected Hessian as an operator */
     const Projection *proj;    /* Dirichlet projection of vectors */
     struct StepProblem *problem; /* for rediscretising methods (GMG) */
+    /* omp_get_wtime() after which an inner iteration does not start (the
+     * solve's --max-step-seconds / --max-run-seconds deadline; 0 = none):
+     * an inner solve stops there with its current iterate */
+    double deadline;
 } InvSetupInput;
 
 /* Capability flags (InvApprox.caps, set by create from the options). */

@@ -122,6 +122,7 @@ int solve_setup_inverse(SolveCtx *c, const Bsr *H, const double *diag, const Lin
         .op = op,
         .proj = proj,
         .problem = pb,
+        .deadline = c->set->deadline,
     };
     int status = inv_setup(c->inv, &in);
     st->setup_s += omp_get_wtime() - t0;

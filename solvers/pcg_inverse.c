@@ -17,7 +17,8 @@ typedef struct {
     PcgWork work;
     double *z;
     int cap, n, max_iters;
-    long applies, capped; /* since the last setup */
+    double deadline;                 /* InvSetupInput.deadline of the last setup */
+    long applies, capped, timed_out; /* since the last setup */
 } InexactPcg;
 
 static int ipcg_create(SolverOptions *opt, InvApprox **out)
@@ -48,7 +49,8 @@ static int ipcg_setup(InvApprox *self, const InvSetupInput *in)
     s->op = in->op;
     s->proj = in->proj;
     s->n = in->n_nodes;
-    s->applies = s->capped = 0;
+    s->deadline = in->deadline;
+    s->applies = s->capped = s->timed_out = 0;
     if (in->n_nodes > s->cap) {
         double *z = realloc(s->z, sizeof(double) * 3 * (size_t)in->n_nodes);
         if (!z) return mpm_error(MPM_EINTERNAL, "out of memory: inexact PCG");
@@ -71,9 +73,19 @@ static int ipcg_apply(InvApprox *self, const double *r, double *z)
     int st = inv_apply(s->jacobi, r, s->z);
     if (st) return st;
     double ref = sqrt(fmax(vec_dot(len, r, s->z), 0.0));
-    PcgOptions po = {.stop = PCG_ABSOLUTE, .abs_tol = 0.5 * ref, .max_iters = s->max_iters};
+    PcgOptions po = {.stop = PCG_ABSOLUTE, .abs_tol = 0.5 * ref, .max_iters = s->max_iters, .deadline = s->deadline};
     PcgResult res;
     st = pcg_solve(s->op, s->jacobi, s->proj, r, z, &po, &s->work, &res);
+    /* past the step's deadline the outer method stops at its next test; until
+     * then it needs a descent direction: with no inner iteration done that is
+     * the block-Jacobi one (z = 0 would stall its line search) */
+    if (!st && res.timed_out && res.iters == 0) { /* z = P D^-1 P r, PCG's first direction */
+        vec_copy(len, r, s->z);
+        projection_apply(s->proj, s->z);
+        st = inv_apply(s->jacobi, s->z, z);
+        if (!st) projection_apply(s->proj, z);
+    }
+    s->timed_out += res.timed_out;
     self->stats.inner_iters += res.iters;
     self->stats.apply_s += omp_get_wtime() - t0;
     s->applies++;
@@ -86,11 +98,12 @@ static void ipcg_view(const InvApprox *self, FILE *f, InvView *out)
     const InexactPcg *s = (const InexactPcg *)self;
     if (f)
         fprintf(f, "  inexact block-Jacobi PCG (stop at 1/2 the input's norm, cap %d): %ld applications, %ld "
-                   "iterations, %ld capped\n",
-                s->max_iters, s->applies, self->stats.inner_iters, s->capped);
+                   "iterations, %ld capped, %ld at the deadline\n",
+                s->max_iters, s->applies, self->stats.inner_iters, s->capped, s->timed_out);
     inv_view_add(out, "applications", (double)s->applies);
     inv_view_add(out, "inner_iters", (double)self->stats.inner_iters);
     inv_view_add(out, "capped", (double)s->capped);
+    inv_view_add(out, "timed_out", (double)s->timed_out);
 }
 
 static void ipcg_destroy(InvApprox *self)

@@ -3,6 +3,7 @@
  * non-positive curvature, singular diagonal blocks, determinism, and flexible
  * CG for a variable preconditioner. */
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,17 +16,19 @@
 #include "tests/synthetic.h"
 #include "tests/testutil.h"
 
-static InvApprox *make_inv(const InvApproxOps *ops, const SynthProblem *p)
+static InvApprox *make_inv_until(const InvApproxOps *ops, const SynthProblem *p, double deadline)
 {
     InvApprox *M = NULL;
     int st = inv_create(ops, NULL, &M);
     CHECK(st == MPM_OK, "%s create: %s", ops->name, mpm_last_error());
     InvSetupInput in = {.n_nodes = p->n, .H = &p->A, .diag = p->diag, .coord = p->coord, .coloring = &p->col,
-                        .op = &p->op, .proj = &p->proj};
+                        .op = &p->op, .proj = &p->proj, .deadline = deadline};
     st = inv_setup(M, &in);
     CHECK(st == MPM_OK, "%s setup: %s", ops->name, mpm_last_error());
     return M;
 }
+
+static InvApprox *make_inv(const InvApproxOps *ops, const SynthProblem *p) { return make_inv_until(ops, p, 0.0); }
 
 /* ||P(b - A x)|| / ||P b|| */
 static double rel_residual(const SynthProblem *p, const double *b, const double *x)
@@ -289,6 +292,36 @@ int main(void)
         CHECK(rr[0][1] < 1e-8 && rr[1][1] < 1e-8, "flexible CG residuals %g %g", rr[0][1], rr[1][1]);
         CHECK(2 * iters[1][1] < iters[1][0], "variable preconditioner: flexible %d vs plain %d iterations",
               iters[1][1], iters[1][0]);
+
+        /* the solve's deadline reaches the inner PCG: with it passed no inner
+         * iteration starts and the direction is the block-Jacobi one; a far
+         * deadline changes nothing */
+        double *zj = malloc(sizeof(double) * lq), *zf = malloc(sizeof(double) * lq);
+        projection_apply(&q.proj, bq); /* a gradient: in the free subspace */
+        InvApprox *late = make_inv_until(&inv_inexact_pcg_ops, &q, omp_get_wtime() - 1.0);
+        InvApprox *far = make_inv_until(&inv_inexact_pcg_ops, &q, omp_get_wtime() + 1e6);
+        st = inv_apply(late, bq, zj);
+        CHECK(st == MPM_OK && inv_inner_iters(late) == 0, "past the deadline: %ld inner iterations (st %d)",
+              inv_inner_iters(late), st);
+        inv_apply(fixed, bq, zf);
+        projection_apply(&q.proj, zf);
+        double dmax = 0.0;
+        for (size_t k = 0; k < lq; ++k) dmax = fmax(dmax, fabs(zj[k] - zf[k]));
+        CHECK(dmax == 0.0, "past the deadline: not the block-Jacobi direction (max difference %g)", dmax);
+        long before = inv_inner_iters(inner);
+        inv_apply(inner, bq, xq);
+        long again = inv_inner_iters(inner) - before;
+        st = inv_apply(far, bq, zf);
+        dmax = 0.0;
+        for (size_t k = 0; k < lq; ++k) dmax = fmax(dmax, fabs(xq[k] - zf[k]));
+        CHECK(st == MPM_OK && inv_inner_iters(far) == again && again > 0 && dmax == 0.0,
+              "a far deadline: %ld inner iterations against %ld without (difference %g)", inv_inner_iters(far),
+              again, dmax);
+        inv_destroy(late);
+        inv_destroy(far);
+        free(zj);
+        free(zf);
+
         inv_destroy(inner);
         inv_destroy(fixed);
         free(bq);
