@@ -82,8 +82,7 @@ static int ipcg_apply(InvApprox *self, const double *r, double *z)
     if (!st && res.timed_out && res.iters == 0) { /* z = P D^-1 P r, PCG's first direction */
         vec_copy(len, r, s->z);
         projection_apply(s->proj, s->z);
-        st = inv_apply(s->jacobi, s->z, z);
-        if (!st) projection_apply(s->proj, z);
+        st = precondition_projected(s->jacobi, s->proj, len, s->z, z);
     }
     s->timed_out += res.timed_out;
     self->stats.inner_iters += res.iters;
