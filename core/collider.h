@@ -1,6 +1,6 @@
 /* Analytic level-set colliders with scripted rigid motion.
  *
- * A collider is a Shape (core/shape.h) in its rest frame plus a rigid
+ * A collider is a Shape (core/scene/shape.h) in its rest frame plus a rigid
  * motion. The world position of rest-frame point X at time t is
  *
  *     x = R(t) (X - pivot0) + pivot0 + b(t),
@@ -68,7 +68,7 @@
 
 #include <jansson.h>
 
-#include "core/shape.h"
+#include "core/scene/shape.h"
 
 typedef enum { COLLIDER_STICKY = 0, COLLIDER_SLIP = 1 } ColliderKind;
 

@@ -17,7 +17,7 @@ typedef struct {
     double *Jp;   /* n plastic volume ratio (snow hardening); NULL unless a material needs it */
     size_t *id;   /* n identities: the particle's index when it was pushed (0, 1, ...; particles are
                      never removed), kept through particles_permute and particles_copy, so runs
-                     can be compared particle by particle (experiments/trajectory.h) */
+                     can be compared particle by particle (experiments/accuracy/trajectory.h) */
 } Particles;
 
 /* Grows capacity to at least `cap` (keeps contents). */

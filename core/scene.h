@@ -83,10 +83,10 @@
  *                                     when the scene has "sources")
  *     {"name": "...",                 optional label
  *      "material": "NAME",            required, a key of "materials"
- *      "shape": {...},                required, see core/shape.h (must be bounded)
+ *      "shape": {...},                required, see core/scene/shape.h (must be bounded)
  *      "ppc": 8,                      required, > 0 particles per dx^3 cell
  *      "sampling": "poisson",         optional: "poisson" (default) | "random" |
- *                                     "lattice" (ppc = k^3), see core/sampler.h
+ *                                     "lattice" (ppc = k^3), see core/scene/sampler.h
  *      "velocity": [0, 0, 0],         optional initial velocity [m/s]
  *      "initial_F": {"type": "random_diagonal", "min": 0.7, "max": 1.3,
  *                    "seed": 7, "per_particle": true}
@@ -107,7 +107,7 @@
  *                                     optional: a clumpy material. With the
  *                                     smooth value noise nu(x) in [-1, 1] of
  *                                     correlation length "length" [m] > 0
- *                                     (core/noise.h), each particle's mass
+ *                                     (core/scene/noise.h), each particle's mass
  *                                     (density) is scaled by
  *                                     1 + amplitude nu(x_p), 0 <= amplitude
  *                                     < 1; if the material is snow with
@@ -139,7 +139,7 @@
  *                                     as particles (hot-scenes.md 1.5).
  *                                     "count": N points spread uniformly by
  *                                     area over the shape's surface
- *                                     (core/sampler.h sampler_surface);
+ *                                     (core/scene/sampler.h sampler_surface);
  *                                     "vertices_of": the vertices of that
  *                                     mesh (transform applied). N (or the
  *                                     vertex count) is for --scale 1: at

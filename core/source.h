@@ -8,7 +8,7 @@
  *    "material": "sand",                required, a key of "materials"
  *    "shape": {...},                    required, bounded (HOT: a sphere)
  *    "ppc": 16,                         required, > 0: Poisson samples per dx^3
- *                                       (realised 0.868 ppc, core/sampler.h)
+ *                                       (realised 0.868 ppc, core/scene/sampler.h)
  *    "velocity": [0, -0.5, 0],          required, nonzero: outflow velocity
  *                                       [m/s] in the source's rest frame
  *    "from": 0,                         optional, default 0 [s]
@@ -67,7 +67,7 @@
 #include "core/collider.h"
 #include "core/material.h"
 #include "core/particles.h"
-#include "core/sampler.h"
+#include "core/scene/sampler.h"
 
 typedef struct Source {
     char name[64];

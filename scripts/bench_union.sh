@@ -3,7 +3,7 @@
 # 0.02 m boxes in a 1 m domain (dx 0.02, ppc 8), loaded and sampled by
 # `mpmbench render --frame 0`. Prints N, particles and wall seconds.
 #   scripts/bench_union.sh [N=20000] [THREADS=2]
-# Before the union's box tree (core/box_tree.h) N = 20000 took > 200 s.
+# Before the union's box tree (core/scene/box_tree.h) N = 20000 took > 200 s.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 n=${1:-20000} threads=${2:-2}

@@ -256,7 +256,7 @@ def robustness(plt, root, md, order, helpers):
     md.append("Pass: every step converged (residual re-checked) or reported capped / stalled / timeout / failed, no "
               "NaN or Inf in the outputs, no line search accepted an energy increase, the run ended inside its "
               "wall-clock limit and particles stayed in the domain or the run said otherwise "
-              "(experiments/matrix_check.h).\n")
+              "(experiments/matrix/matrix_check.h).\n")
     table = []
     for case in cases:
         line = [case]

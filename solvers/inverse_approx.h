@@ -9,11 +9,11 @@
  *
  * An implementation embeds `InvApprox` as its first member, sets `caps` in
  * create and provides an InvApproxOps table; adding one is a new file plus
- * one line in experiments/registry.c. Nothing outside the implementation's
+ * one line in experiments/run/registry.c. Nothing outside the implementation's
  * file knows its type: its statistics come through the view op. Callers go
  * through the inv_* wrappers below, which keep the object's state (apply
  * before a successful setup is refused) and count inner iterations across
- * setups. tests/test_conformance.c checks every registered implementation
+ * setups. tests/conformance/test_conformance.c checks every registered implementation
  * against this contract. */
 #ifndef MPM_INVERSE_APPROX_H
 #define MPM_INVERSE_APPROX_H
@@ -23,7 +23,7 @@
 
 #include "core/bsr.h"
 #include "core/node_order.h"
-#include "solvers/linear_op.h"
+#include "solvers/krylov/linear_op.h"
 #include "solvers/options.h"
 
 struct StepProblem;
@@ -103,7 +103,7 @@ struct InvApprox {
     const InvApproxOps *ops;
     unsigned caps;      /* INV_* */
     InvStats stats;
-    /* outer PCG uses the flexible-CG beta (solvers/pcg.c); usually
+    /* outer PCG uses the flexible-CG beta (solvers/krylov/pcg.c); usually
      * caps & INV_VARIABLE, an option may turn it off (mg flexible=0) */
     int flexible;
     /* kept by the wrappers */

@@ -1,5 +1,5 @@
 /* The line-search strategies (see line_search.h). Both backtracking rules
- * are core/linesearch.c's (SPEC 5: alpha = 1, halve until accepted, at most
+ * are solvers/backtracking.c's (SPEC 5: alpha = 1, halve until accepted, at most
  * max_halvings halvings); the strong Wolfe search is below. */
 #include "solvers/line_search.h"
 
@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "core/error.h"
-#include "core/linesearch.h"
+#include "solvers/backtracking.h"
 #include "core/vec.h"
 
 static int backtrack(int armijo, StepProblem *pb, const double *dv, const double *p, double E0, double gTp,

@@ -12,7 +12,7 @@
  * the strategy evaluated it anyway, g_new = g(dv_new) with have_gradient = 1
  * (else the caller evaluates it). With no acceptable alpha it sets stalled,
  * leaves the cache at dv and says why in `why`. It never accepts an energy
- * above E0 (tests/test_conformance.c). */
+ * above E0 (tests/conformance/test_conformance.c). */
 #ifndef MPM_LINE_SEARCH_H
 #define MPM_LINE_SEARCH_H
 

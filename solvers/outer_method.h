@@ -1,6 +1,6 @@
 /* The outer-method interface (DESIGN "the one idea"): projected Newton,
  * L-BFGS, ... as objects with an ops table and a private context, registered
- * by name in experiments/registry.c like the inverse approximations.
+ * by name in experiments/run/registry.c like the inverse approximations.
  *
  * A method minimises the step problem's incremental potential from dv. It is
  * handed, in a SolveCtx, everything that is not its own algorithm: the
@@ -13,7 +13,7 @@
  *  - solve_assemble() / solve_setup_inverse() / solve_line_search() for the
  *    phases timed in SolveStats.
  * Adding an outer method is one new file defining its OuterMethodOps and one
- * line in experiments/registry.c; tests/test_conformance.c then checks it
+ * line in experiments/run/registry.c; tests/conformance/test_conformance.c then checks it
  * (when it claims OUTER_TO_TOLERANCE: reaches eps, honours the cap with
  * status capped, stalls at an unreachable tolerance; when it claims
  * OUTER_DESCENT: never accepts an energy increase).

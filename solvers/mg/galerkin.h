@@ -12,7 +12,7 @@
 #define MPM_MG_GALERKIN_H
 
 #include "core/bsr.h"
-#include "solvers/mg/transfer.h"
+#include "solvers/mg/embedding.h"
 
 /* Per-thread accumulators and output buffers, kept between calls so that
  * steady-state setups allocate nothing. */

@@ -14,7 +14,7 @@
 #define MPM_MG_GMG_LEVEL_H
 
 #include "core/problem.h"
-#include "solvers/mg/transfer.h"
+#include "solvers/mg/embedding.h"
 
 typedef struct {
     Particles parts;

@@ -9,12 +9,12 @@
 
 #include "core/error.h"
 #include "core/vec.h"
-#include "solvers/jacobi.h"
+#include "solvers/inverse/jacobi.h"
 #include "solvers/mg/galerkin.h"
 #include "solvers/mg/gmg_level.h"
-#include "solvers/mg/transfer.h"
-#include "solvers/pcg.h"
-#include "solvers/sgs.h"
+#include "solvers/mg/embedding.h"
+#include "solvers/krylov/pcg.h"
+#include "solvers/inverse/sgs.h"
 
 /* What the view op reports: the hierarchy of the last setup and the work
  * done by V-cycles since. */
@@ -138,7 +138,7 @@ static int mg_create(SolverOptions *opt, InvApprox **out)
     M->cj.base.ops = &coarse_jacobi_ops;
     M->cj.base.ready = 1; /* shares the level's D^-1, set up with the hierarchy */
     /* the adaptive coarsest PCG makes the V-cycle vary with its input (to
-     * 1e-12 with coarse_exact=1: then symmetric, as tests/test_mg.c checks);
+     * 1e-12 with coarse_exact=1: then symmetric, as tests/unit/test_mg.c checks);
      * outer PCG uses flexible CG unless flexible=0 (the reference's plain PCG) */
     M->base.caps = INV_NEEDS_MATRIX | INV_POSITIVE | INV_INNER_ITERS | (rediscretize ? INV_NEEDS_PROBLEM : 0u) |
                    (exact ? INV_SYMMETRIC : INV_VARIABLE);

@@ -1,4 +1,4 @@
-/* libFuzzer harness: the OBJ mesh loader (core/mesh.h) and queries on what
+/* libFuzzer harness: the OBJ mesh loader (core/scene/mesh.h) and queries on what
  * it accepts (inside test, signed distance, volume: they walk the
  * bounding-volume hierarchy the loader builds). */
 #include <math.h>
@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "core/error.h"
-#include "core/mesh.h"
+#include "core/scene/mesh.h"
 #include "tests/fuzz/harness.h"
 
 int LLVMFuzzerInitialize(int *argc, char ***argv)

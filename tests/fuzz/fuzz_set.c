@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "core/error.h"
-#include "core/sampler.h"
+#include "core/scene/sampler.h"
 #include "core/scene.h"
 #include "tests/fuzz/harness.h"
 

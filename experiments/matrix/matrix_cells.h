@@ -1,0 +1,73 @@
+/* The cells of an experiment matrix: one point of the product of its axes
+ * after the include/exclude rules, with its effective settings (defaults <
+ * per-scene settings < axis values), a stable id and the `mpmbench run`
+ * command line that computes it.
+ *
+ * Id: the first 12 hex digits of the 64-bit FNV-1a hash of the canonical
+ * serialisation of the effective settings (JSON, sorted keys, no spaces,
+ * reals with 17 significant digits; overrides and solver options as sorted
+ * key: text objects). It depends on nothing else: not on the order of the
+ * axes, on the other values of an axis, on axis labels or on the asset
+ * directory (which locates files but does not change a setting). Cells with
+ * the same canonical settings are one cell (the first keeps its labels). */
+#ifndef MPM_MATRIX_CELLS_H
+#define MPM_MATRIX_CELLS_H
+
+#include "experiments/matrix/matrix_file.h"
+
+typedef struct {
+    char id[16];
+    char scene[1024];            /* as in the matrix */
+    char solver[128];
+    double eps, scale;
+    int threads;                 /* 0: OpenMP's default */
+    int frames;                  /* 0: the scene's */
+    int first_timed_frame;
+    int history, armijo, particles;
+    char asset_dir[1024];        /* "" = none */
+    MatrixKv *set, *solver_opts; /* merged, sorted by key */
+    int n_set, n_solver_opts;
+    int value[MATRIX_MAX_AXES];  /* value index of each named axis */
+    char scene_origin[256], solver_origin[256];
+    char *canonical;
+    double timeout_s;            /* 0 = none */
+    char error_ref[160];         /* "" = none */
+    int trajectory;
+    int max_outer, max_linear;   /* 0 = run's default */
+    double max_step_s, max_run_s;/* 0 = none */
+    char on_failure[16];         /* "" = run's default (stop) */
+    int is_reference;            /* a reference run other cells depend on */
+    int ref;                     /* index of this cell's reference cell, -1 = none */
+    char ref_id[16];             /* its id ("" = none) */
+} MatrixCell;
+
+typedef struct {
+    MatrixCell *cells;
+    int n;
+} MatrixCells;
+
+/* Every cell of the matrix, in product order (scene slowest, then solver,
+ * eps, scale, threads, error_ref, the named axes in file order), rules
+ * applied, duplicates removed; the reference cells (matrix_file.h
+ * "reference") first, in the order they are first needed. A dependent
+ * cell's canonical settings include its reference's id. MPM_EINPUT when a
+ * cell's settings are inconsistent (a first timed frame not before its
+ * frames). */
+int matrix_expand(const Matrix *m, MatrixCells *out);
+void matrix_cells_free(MatrixCells *c);
+/* Keeps the cells i with keep[i] != 0, in order (the reference indices
+ * renumbered; a kept cell's reference must be kept). */
+void matrix_cells_keep(MatrixCells *c, const int *keep);
+
+/* "scene/solver" */
+void matrix_cell_name(const MatrixCell *c, char *out, size_t n);
+/* "eps=1e-07 scale=4.3 threads=2 frames=1 stiffness=1e+05 ..." */
+void matrix_cell_describe(const Matrix *m, const MatrixCell *c, char *out, size_t n);
+
+/* The `mpmbench run` arguments (without the program) that compute the cell
+ * into out_dir, NUL-separated in buf; *argc set. MPM_EINPUT if too long. A
+ * dependent cell gets --dt-from and --trajectory-ref with its reference's
+ * directory, the sibling of out_dir named by the reference's id. */
+int matrix_cell_argv(const Matrix *m, const MatrixCell *c, const char *out_dir, char *buf, size_t cap, int *argc);
+
+#endif

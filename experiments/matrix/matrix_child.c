@@ -1,0 +1,131 @@
+#include "experiments/matrix/matrix_child.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/prctl.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "core/error.h"
+
+extern char **environ;
+
+/* wait4 is BSD/GNU; declared here so the file builds with _POSIX_C_SOURCE. */
+pid_t wait4(pid_t pid, int *status, int options, struct rusage *rusage);
+
+double matrix_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void matrix_sleep_ms(int ms)
+{
+    struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
+    while (nanosleep(&ts, &ts) != 0 && errno == EINTR) {
+    }
+}
+
+int matrix_is_launcher_env(const char *entry)
+{
+    /* OpenMPI (OMPI_, OPAL_, ORTE_, PRTE_), PMIx, MPICH/Hydra (PMI_, HYDRA_, MPIR_), Intel MPI (I_MPI_) */
+    static const char *const prefixes[] = {"OMPI_", "OPAL_", "ORTE_", "PRTE_", "PMIX_", "PMI_", "HYDRA_", "MPIR_",
+                                           "I_MPI_", "MPI_LOCALRANKID=", "MPI_LOCALNRANKS="};
+    for (size_t i = 0; i < sizeof prefixes / sizeof prefixes[0]; ++i)
+        if (!strncmp(entry, prefixes[i], strlen(prefixes[i]))) return 1;
+    return 0;
+}
+
+static int open_out(const char *dir, const char *name)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    return open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+}
+
+int cell_child_start(char *const *args, int argc, const char *dir, double timeout_s, CellChild *c)
+{
+    memset(c, 0, sizeof *c);
+    /* everything the child needs is prepared before fork: after it, only
+     * async-signal-safe calls until execve */
+    size_t n_env = 0;
+    while (environ[n_env]) n_env++;
+    char **env = malloc(sizeof *env * (n_env + 1));
+    char **argv = malloc(sizeof *argv * (size_t)(argc + 2));
+    int out = open_out(dir, "stdout.txt"), err = open_out(dir, "stderr.txt");
+    int in = open("/dev/null", O_RDONLY | O_CLOEXEC);
+    long max_fd = sysconf(_SC_OPEN_MAX);
+    if (max_fd < 0 || max_fd > 65536) max_fd = 65536;
+    int st = MPM_OK;
+    if (!env || !argv) st = mpm_error(MPM_EINTERNAL, "out of memory starting a cell");
+    else if (out < 0 || err < 0 || in < 0) st = mpm_error(MPM_EINTERNAL, "%s: cannot create the cell's output files", dir);
+    pid_t parent = getpid();
+    pid_t pid = -1;
+    if (!st) {
+        size_t k = 0;
+        for (size_t i = 0; i < n_env; ++i)
+            if (!matrix_is_launcher_env(environ[i])) env[k++] = environ[i];
+        env[k] = NULL;
+        argv[0] = "mpmbench";
+        for (int i = 0; i < argc; ++i) argv[i + 1] = args[i];
+        argv[argc + 1] = NULL;
+        pid = fork();
+        if (pid < 0) st = mpm_error(MPM_EINTERNAL, "fork failed starting a cell in %s", dir);
+    }
+    if (pid == 0) {
+        setpgid(0, 0);
+        prctl(PR_SET_PDEATHSIG, SIGKILL);
+        if (getppid() != parent) _exit(127); /* the runner died before prctl */
+        sigset_t none;
+        sigemptyset(&none);
+        sigprocmask(SIG_SETMASK, &none, NULL);
+        signal(SIGPIPE, SIG_DFL);
+        signal(SIGINT, SIG_DFL);
+        signal(SIGTERM, SIG_DFL);
+        dup2(in, 0);
+        dup2(out, 1);
+        dup2(err, 2);
+        for (long fd = 3; fd < max_fd; ++fd) close((int)fd);
+        execve("/proc/self/exe", argv, env);
+        _exit(127);
+    }
+    if (pid > 0) {
+        setpgid(pid, pid); /* also here: no race with a kill of the group */
+        c->pid = pid;
+        c->t_start = matrix_now();
+        c->timeout_s = timeout_s;
+    }
+    if (out >= 0) close(out);
+    if (err >= 0) close(err);
+    if (in >= 0) close(in);
+    free(env);
+    free(argv);
+    return st;
+}
+
+int cell_child_poll(CellChild *c, CellOutcome *out)
+{
+    if (!c->pid) return 0;
+    double now = matrix_now();
+    if (!c->timed_out && c->timeout_s > 0 && now - c->t_start > c->timeout_s) {
+        kill(-c->pid, SIGKILL);
+        c->timed_out = 1;
+    }
+    int status = 0;
+    struct rusage ru;
+    memset(&ru, 0, sizeof ru);
+    pid_t r = wait4(c->pid, &status, WNOHANG, &ru);
+    if (r == 0) return 0;
+    if (r < 0 && errno == EINTR) return 0;
+    if (r < 0) status = 0x7f00; /* lost (ECHILD): reported as a failed exit 127 */
+    *out = cell_outcome(status, c->timed_out, now - c->t_start, ru.ru_maxrss);
+    c->pid = 0;
+    return 1;
+}

@@ -1,0 +1,338 @@
+#include "experiments/matrix/matrix_dispatch.h"
+
+#include <mpi.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "experiments/matrix/matrix_child.h"
+#include "experiments/matrix/matrix_results.h"
+#include "experiments/run/paths.h"
+
+enum { TAG_REQUEST = 1, TAG_TASK = 2, TAG_STOP = 3, TAG_RESULT = 4 };
+enum { POLL_MS = 5, MAX_ARGS = 512 };
+
+/* ---------------------------------------------------------------- local slots */
+
+typedef struct {
+    MatrixTask task;
+    CellChild child;
+    int busy;
+} Slot;
+
+/* DIR/cmd.txt: the command line, shell-quoted, to rerun the cell by hand. */
+static void write_command(const MatrixTask *t, char *const *args)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/cmd.txt", t->dir);
+    FILE *f = fopen(path, "w");
+    if (!f) return;
+    fputs("mpmbench", f);
+    for (int i = 0; i < t->argc; ++i) {
+        int plain = args[i][0] != '\0';
+        for (const char *c = args[i]; *c && plain; ++c) plain = strchr("/._-=:+,", *c) || (*c >= '0' && *c <= '9') ||
+                                                              (*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z');
+        if (plain) {
+            fprintf(f, " %s", args[i]);
+            continue;
+        }
+        fputs(" '", f);
+        for (const char *c = args[i]; *c; ++c) {
+            if (*c == '\'') fputs("'\\''", f);
+            else fputc(*c, f);
+        }
+        fputc('\'', f);
+    }
+    fputc('\n', f);
+    fclose(f);
+}
+
+static int slot_start(Slot *s, const MatrixTask *t)
+{
+    memcpy(&s->task, t, offsetof(MatrixTask, args) + (size_t)t->args_len);
+    char *args[MAX_ARGS];
+    if (t->argc > MAX_ARGS) return mpm_error(MPM_EINTERNAL, "cell %s: too many arguments", t->dir);
+    size_t off = 0;
+    for (int i = 0; i < t->argc; ++i) {
+        args[i] = s->task.args + off;
+        off += strlen(args[i]) + 1;
+    }
+    /* whatever is there is a cell that did not finish: redo it from scratch */
+    int st = matrix_remove_tree(t->dir);
+    if (!st) st = paths_mkdir_p(t->dir);
+    if (st) return st;
+    write_command(&s->task, args);
+    if ((st = cell_child_start(args, t->argc, t->dir, t->timeout_s, &s->child))) return st;
+    s->busy = 1;
+    return MPM_OK;
+}
+
+static int slot_poll(Slot *s, int rank, MatrixResult *r)
+{
+    CellOutcome o;
+    if (!s->busy || !cell_child_poll(&s->child, &o)) return 0;
+    memset(r, 0, sizeof *r);
+    r->index = s->task.index;
+    r->rank = rank;
+    r->outcome = o;
+    cell_measure(s->task.dir, s->task.first_timed_frame, &r->measure);
+    s->busy = 0;
+    return 1;
+}
+
+static int count_busy(const Slot *s, int n)
+{
+    int b = 0;
+    for (int i = 0; i < n; ++i) b += s[i].busy;
+    return b;
+}
+
+static Slot *free_slot(Slot *s, int n)
+{
+    for (int i = 0; i < n; ++i)
+        if (!s[i].busy) return &s[i];
+    return NULL;
+}
+
+/* ---------------------------------------------------------------- MPI outbox */
+
+/* Non-blocking sends whose buffers live until MPI says they are done. */
+typedef struct {
+    MPI_Request req[64];
+    void *buf[64];
+    int n;
+} Outbox;
+
+static void outbox_progress(Outbox *o)
+{
+    for (int i = 0; i < o->n;) {
+        int done = 0;
+        MPI_Test(&o->req[i], &done, MPI_STATUS_IGNORE);
+        if (!done) {
+            ++i;
+            continue;
+        }
+        free(o->buf[i]);
+        o->req[i] = o->req[o->n - 1];
+        o->buf[i] = o->buf[o->n - 1];
+        o->n--;
+    }
+}
+
+static int outbox_send(Outbox *o, const void *data, int bytes, int dest, int tag)
+{
+    while (o->n == 64) {
+        outbox_progress(o);
+        if (o->n == 64) matrix_sleep_ms(1);
+    }
+    void *b = malloc(bytes > 0 ? (size_t)bytes : 1);
+    if (!b) return mpm_error(MPM_EINTERNAL, "out of memory (MPI message)");
+    if (bytes > 0) memcpy(b, data, (size_t)bytes); /* a zero-length message may come with data == NULL */
+    o->buf[o->n] = b;
+    if (MPI_Isend(b, bytes, MPI_BYTE, dest, tag, MPI_COMM_WORLD, &o->req[o->n]) != MPI_SUCCESS) {
+        free(b);
+        return mpm_error(MPM_EINTERNAL, "MPI_Isend to rank %d failed", dest);
+    }
+    o->n++;
+    return MPM_OK;
+}
+
+static void outbox_flush(Outbox *o)
+{
+    while (o->n) {
+        outbox_progress(o);
+        if (o->n) matrix_sleep_ms(1);
+    }
+}
+
+static int task_bytes(const MatrixTask *t) { return (int)(offsetof(MatrixTask, args) + (size_t)t->args_len); }
+
+/* ---------------------------------------------------------------- rank 0 */
+
+enum { TASK_PENDING = 0, TASK_RUNNING, TASK_OK, TASK_NOT_OK, TASK_SKIPPED };
+
+/* Rank 0's view of the task list: which are pending, running, done. */
+typedef struct {
+    const MatrixTask *tasks;
+    int n;
+    unsigned char *state;
+    int finished;   /* done or skipped */
+    int pending;    /* not handed out, not skipped */
+    const MatrixDispatchHooks *h;
+} Board;
+
+/* The first pending task whose dependency ended ok (-1: none ready); tasks
+ * whose dependency did not are skipped on the way. */
+static int board_pick(Board *b)
+{
+    for (int i = 0; i < b->n; ++i) {
+        if (b->state[i] != TASK_PENDING) continue;
+        int a = b->tasks[i].after;
+        int dep = a >= 0 && a < b->n ? b->state[a] : TASK_OK;
+        if (dep == TASK_OK) return i;
+        if (dep == TASK_NOT_OK || dep == TASK_SKIPPED) {
+            b->state[i] = TASK_SKIPPED;
+            b->finished++;
+            b->pending--;
+            if (b->h->skipped) b->h->skipped(b->h->ctx, &b->tasks[i], a >= 0 ? &b->tasks[a] : NULL);
+            i = -1; /* a skip may unblock nothing but skip more: scan again */
+        }
+    }
+    return -1;
+}
+
+static void board_hand_out(Board *b, int i)
+{
+    b->state[i] = TASK_RUNNING;
+    b->pending--;
+}
+
+/* A result of the task with caller's index `index`. */
+static void board_done(Board *b, const MatrixResult *r)
+{
+    for (int i = 0; i < b->n; ++i)
+        if (b->tasks[i].index == r->index && b->state[i] == TASK_RUNNING) {
+            b->state[i] = r->outcome.status == CELL_OK ? TASK_OK : TASK_NOT_OK;
+            b->finished++;
+            return;
+        }
+}
+
+static int serve(const MatrixTask *tasks, int n, int jobs, int use_mpi, const MatrixDispatchHooks *h)
+{
+    int ranks = 1;
+    if (use_mpi) MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+    Slot *slots = calloc((size_t)jobs, sizeof *slots);
+    Board b = {tasks, n, calloc((size_t)n + 1, 1), 0, n, h};
+    int *waiting = calloc((size_t)ranks, sizeof *waiting); /* ranks asking while no task was ready */
+    if (!slots || !b.state || !waiting) {
+        free(slots);
+        free(b.state);
+        free(waiting);
+        return mpm_error(MPM_EINTERNAL, "out of memory");
+    }
+    Outbox out = {.n = 0};
+    int n_waiting = 0, stopped = 0, remote_running = 0, st = MPM_OK;
+    while (!st && (b.finished < n || stopped < ranks - 1)) {
+        int busy_round = 0;
+        MatrixResult r;
+        for (int i = 0; i < jobs && !st; ++i)
+            if (slot_poll(&slots[i], 0, &r)) {
+                board_done(&b, &r);
+                busy_round = 1;
+                st = h->done(h->ctx, &r);
+            }
+        Slot *s;
+        int next;
+        while (!st && (s = free_slot(slots, jobs)) && (next = board_pick(&b)) >= 0) {
+            board_hand_out(&b, next);
+            st = slot_start(s, &tasks[next]);
+            busy_round = 1;
+        }
+        while (!st && use_mpi) {
+            int flag = 0;
+            MPI_Status ms;
+            MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &ms);
+            if (!flag) break;
+            busy_round = 1;
+            if (ms.MPI_TAG == TAG_REQUEST) {
+                MPI_Recv(NULL, 0, MPI_BYTE, ms.MPI_SOURCE, TAG_REQUEST, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                waiting[n_waiting++] = ms.MPI_SOURCE; /* answered below */
+            } else if (ms.MPI_TAG == TAG_RESULT) {
+                MPI_Recv(&r, (int)sizeof r, MPI_BYTE, ms.MPI_SOURCE, TAG_RESULT, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                remote_running--;
+                board_done(&b, &r);
+                st = h->done(h->ctx, &r);
+            } else {
+                st = mpm_error(MPM_EINTERNAL, "unexpected MPI message (tag %d) from rank %d", ms.MPI_TAG, ms.MPI_SOURCE);
+            }
+        }
+        /* the waiting ranks: a ready task each, or stop once nothing is left to hand out */
+        while (!st && n_waiting > 0) {
+            next = board_pick(&b);
+            int dest = waiting[0];
+            if (next >= 0) {
+                board_hand_out(&b, next);
+                st = outbox_send(&out, &tasks[next], task_bytes(&tasks[next]), dest, TAG_TASK);
+                remote_running++;
+            } else if (b.pending == 0) {
+                st = outbox_send(&out, NULL, 0, dest, TAG_STOP);
+                stopped++;
+            } else {
+                break; /* every remaining task waits for a running one */
+            }
+            memmove(waiting, waiting + 1, sizeof *waiting * (size_t)--n_waiting);
+            busy_round = 1;
+        }
+        if (use_mpi) outbox_progress(&out);
+        if (h->tick) h->tick(h->ctx, count_busy(slots, jobs) + remote_running);
+        if (!busy_round) matrix_sleep_ms(POLL_MS);
+    }
+    if (use_mpi && !st) outbox_flush(&out);
+    free(slots);
+    free(b.state);
+    free(waiting);
+    return st;
+}
+
+/* ---------------------------------------------------------------- ranks > 0 */
+
+static int work(int jobs)
+{
+    int rank;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    Slot *slots = calloc((size_t)jobs, sizeof *slots);
+    MatrixTask *task = malloc(sizeof *task);
+    if (!slots || !task) {
+        free(slots);
+        free(task);
+        return mpm_error(MPM_EINTERNAL, "out of memory");
+    }
+    Outbox out = {.n = 0};
+    int asked = 0, stop = 0, st = MPM_OK;
+    while (!st && (!stop || count_busy(slots, jobs))) {
+        int busy_round = 0;
+        MatrixResult r;
+        for (int i = 0; i < jobs && !st; ++i)
+            if (slot_poll(&slots[i], rank, &r)) {
+                busy_round = 1;
+                st = outbox_send(&out, &r, (int)sizeof r, 0, TAG_RESULT);
+            }
+        if (!st && !stop && !asked && free_slot(slots, jobs)) {
+            st = outbox_send(&out, NULL, 0, 0, TAG_REQUEST);
+            asked = 1;
+        }
+        if (!st && asked) {
+            int flag = 0;
+            MPI_Status ms;
+            MPI_Iprobe(0, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &ms);
+            if (flag) {
+                busy_round = 1;
+                asked = 0;
+                if (ms.MPI_TAG == TAG_TASK) {
+                    MPI_Recv(task, (int)sizeof *task, MPI_BYTE, 0, TAG_TASK, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                    st = slot_start(free_slot(slots, jobs), task);
+                } else {
+                    MPI_Recv(NULL, 0, MPI_BYTE, 0, ms.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                    stop = 1;
+                }
+            }
+        }
+        outbox_progress(&out);
+        if (!busy_round) matrix_sleep_ms(POLL_MS);
+    }
+    if (!st) outbox_flush(&out);
+    free(slots);
+    free(task);
+    return st;
+}
+
+int matrix_dispatch(const MatrixTask *tasks, int n, int jobs, int use_mpi, const MatrixDispatchHooks *hooks)
+{
+    if (jobs < 1) jobs = 1;
+    int rank = 0;
+    if (use_mpi) MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    return rank == 0 ? serve(tasks, n, jobs, use_mpi, hooks) : work(jobs);
+}

@@ -1,0 +1,720 @@
+/* Loading and validating experiment-matrix files (format in matrix_file.h). */
+#include "experiments/matrix/matrix_file.h"
+
+#include <ctype.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "core/error.h"
+#include "core/scene.h"
+#include "experiments/accuracy/error_ref.h"
+#include "experiments/run/registry.h"
+
+/* Column names of cells.csv a named axis may not take. */
+static const char *const g_reserved[] = {"id",          "scene",  "solver", "eps",      "scale",
+                                         "threads",     "frames_asked", "first_timed_frame", "set", "solver_opts",
+                                         "status",      "exit",   "error_ref", "role",   "reference"};
+
+void matrix_format_number(double v, char *out, size_t n)
+{
+    for (int p = 1; p <= 17; ++p) {
+        snprintf(out, n, "%.*g", p, v);
+        if (strtod(out, NULL) == v) return;
+    }
+}
+
+/* The value as compact JSON text, shortened, for messages. */
+static void value_text(json_t *v, char *out, size_t n)
+{
+    char *s = v ? json_dumps(v, JSON_ENCODE_ANY | JSON_COMPACT) : NULL;
+    if (!s) {
+        snprintf(out, n, "%s", v ? "?" : "nothing");
+        return;
+    }
+    if (strlen(s) + 1 > n && n > 4) snprintf(out, n, "%.*s...", (int)(n - 4), s);
+    else snprintf(out, n, "%s", s);
+    free(s);
+}
+
+static int bad_value(const Matrix *m, const char *path, json_t *v, const char *expected)
+{
+    char t[96];
+    value_text(v, t, sizeof t);
+    return mpm_error(MPM_EINPUT, "%s: %s: expected %s, got %s", m->base, path, expected, t);
+}
+
+/* Every key of obj must be in `known` (NULL-terminated). */
+static int check_keys(const Matrix *m, json_t *obj, const char *path, const char *const *known)
+{
+    const char *key;
+    json_t *v;
+    json_object_foreach(obj, key, v) {
+        int ok = 0;
+        for (int i = 0; known[i] && !ok; ++i) ok = strcmp(key, known[i]) == 0;
+        if (ok) continue;
+        char list[512] = "";
+        size_t len = 0;
+        for (int i = 0; known[i] && len < sizeof list; ++i)
+            len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", i ? ", " : "", known[i]);
+        return mpm_error(MPM_EINPUT, "%s: %s%s%s: unknown key (known: %s)", m->base, path, path[0] ? "." : "", key,
+                         list);
+    }
+    return MPM_OK;
+}
+
+static void join_path(char *out, size_t n, const char *base, const char *key)
+{
+    snprintf(out, n, "%s%s%s", base, base[0] ? "." : "", key);
+}
+
+static int get_positive(const Matrix *m, json_t *v, const char *path, double *out)
+{
+    if (!json_is_number(v) || !(json_number_value(v) > 0.0) || !isfinite(json_number_value(v)))
+        return bad_value(m, path, v, "a positive number");
+    *out = json_number_value(v);
+    return MPM_OK;
+}
+
+static int get_int(const Matrix *m, json_t *v, const char *path, int lo, int *out)
+{
+    char want[64];
+    snprintf(want, sizeof want, "an integer >= %d", lo);
+    if (!json_is_integer(v) || json_integer_value(v) < lo || json_integer_value(v) > 1000000000)
+        return bad_value(m, path, v, want);
+    *out = (int)json_integer_value(v);
+    return MPM_OK;
+}
+
+static int get_bool(const Matrix *m, json_t *v, const char *path, int *out)
+{
+    if (!json_is_boolean(v)) return bad_value(m, path, v, "true or false");
+    *out = json_is_true(v);
+    return MPM_OK;
+}
+
+static int get_string(const Matrix *m, json_t *v, const char *path, char *out, size_t n)
+{
+    if (!json_is_string(v) || !json_string_value(v)[0]) return bad_value(m, path, v, "a non-empty string");
+    if (strlen(json_string_value(v)) >= n) return bad_value(m, path, v, "a shorter string");
+    snprintf(out, n, "%s", json_string_value(v));
+    return MPM_OK;
+}
+
+void matrix_scene_path(const Matrix *m, const char *scene, char *out, size_t n)
+{
+    size_t len = strlen(scene);
+    int builtin = !strchr(scene, '/') && !(len >= 5 && strcmp(scene + len - 5, ".json") == 0);
+    if (builtin || scene[0] == '/') snprintf(out, n, "%s", scene);
+    else snprintf(out, n, "%s/%s", m->dir, scene);
+}
+
+static int file_exists(const char *p)
+{
+    struct stat st;
+    return stat(p, &st) == 0 && S_ISREG(st.st_mode);
+}
+
+static int get_scene(const Matrix *m, json_t *v, const char *path, char *out, size_t n)
+{
+    int st = get_string(m, v, path, out, n);
+    if (st) return st;
+    char p[2048];
+    matrix_scene_path(m, out, p, sizeof p);
+    if (strcmp(p, out) == 0 && !strchr(out, '/')) { /* built-in name */
+        char f[2048];
+        snprintf(f, sizeof f, "%s/%s.json", scene_dir(), out);
+        if (!file_exists(f))
+            return mpm_error(MPM_EINPUT, "%s: %s: unknown scene \"%s\" (not in %s; see: mpmbench list scenes)", m->base,
+                             path, out, scene_dir());
+    } else if (!file_exists(p)) {
+        return mpm_error(MPM_EINPUT, "%s: %s: scene file \"%s\" not found (%s)", m->base, path, out, p);
+    }
+    return MPM_OK;
+}
+
+static int get_solver(const Matrix *m, json_t *v, const char *path, char *out, size_t n)
+{
+    int st = get_string(m, v, path, out, n);
+    if (st) return st;
+    if (solver_spec_check(out, NULL, 0) != MPM_OK) {
+        char msg[1024];
+        snprintf(msg, sizeof msg, "%s", mpm_last_error());
+        mpm_clear_error();
+        return mpm_error(MPM_EINPUT, "%s: %s: %s", m->base, path, msg);
+    }
+    return MPM_OK;
+}
+
+/* A set / solver_opts object into key=value text, merged on top of `list`. */
+static int get_kv(const Matrix *m, json_t *obj, const char *path, MatrixNamedKind kind, MatrixKvList *list)
+{
+    if (!json_is_object(obj)) return bad_value(m, path, obj, "an object of key: value");
+    size_t key_cap = kind == MATRIX_SET ? sizeof list->kv[0].key : 32;
+    size_t val_cap = kind == MATRIX_SET ? sizeof list->kv[0].value : 64;
+    const char *key;
+    json_t *v;
+    json_object_foreach(obj, key, v) {
+        char p[256], text[256];
+        join_path(p, sizeof p, path, key);
+        if (!key[0] || strlen(key) >= key_cap || strchr(key, '=') || strchr(key, ','))
+            return mpm_error(MPM_EINPUT, "%s: %s: bad key \"%s\" (non-empty, under %zu characters, no '=' or ',')",
+                             m->base, path, key, key_cap);
+        if (json_is_string(v)) {
+            if (!json_string_value(v)[0]) return bad_value(m, p, v, "a non-empty value");
+            snprintf(text, sizeof text, "%s", json_string_value(v));
+        } else if (json_is_integer(v)) {
+            snprintf(text, sizeof text, "%lld", (long long)json_integer_value(v));
+        } else if (json_is_real(v)) {
+            if (!isfinite(json_real_value(v))) return bad_value(m, p, v, "a finite number");
+            matrix_format_number(json_real_value(v), text, sizeof text);
+        } else if (json_is_boolean(v)) {
+            snprintf(text, sizeof text, "%s", kind == MATRIX_SET ? (json_is_true(v) ? "true" : "false")
+                                                                 : (json_is_true(v) ? "1" : "0"));
+        } else if (kind == MATRIX_SET && (json_is_array(v) || json_is_object(v))) {
+            char *s = json_dumps(v, JSON_COMPACT | JSON_REAL_PRECISION(17));
+            if (!s) return mpm_error(MPM_EINTERNAL, "out of memory");
+            snprintf(text, sizeof text, "%s", s);
+            size_t len = strlen(s);
+            free(s);
+            if (len >= sizeof text) return bad_value(m, p, v, "a shorter value");
+        } else {
+            return bad_value(m, p, v, kind == MATRIX_SET ? "a JSON value" : "a number, string or boolean");
+        }
+        if (strlen(text) >= val_cap) return bad_value(m, p, v, "a shorter value");
+        if (strpbrk(text, "\n\r")) return bad_value(m, p, v, "a value on one line");
+        if (kind == MATRIX_SOLVER_OPTS && strchr(text, ','))
+            return bad_value(m, p, v, "a value without ','");
+        int slot = -1;
+        for (int i = 0; i < list->n; ++i)
+            if (strcmp(list->kv[i].key, key) == 0) slot = i;
+        if (slot < 0) {
+            if (list->n >= MATRIX_MAX_KV)
+                return mpm_error(MPM_EINPUT, "%s: %s: more than %d entries", m->base, path, MATRIX_MAX_KV);
+            slot = list->n++;
+        }
+        snprintf(list->kv[slot].key, sizeof list->kv[slot].key, "%s", key);
+        snprintf(list->kv[slot].value, sizeof list->kv[slot].value, "%s", text);
+        snprintf(list->kv[slot].origin, sizeof list->kv[slot].origin, "%s", p);
+    }
+    return MPM_OK;
+}
+
+static int get_error_ref(const Matrix *m, json_t *v, const char *path, char *out, size_t n)
+{
+    int st = get_string(m, v, path, out, n);
+    if (st) return st;
+    if (error_ref_check(out) != MPM_OK) {
+        char msg[1024];
+        snprintf(msg, sizeof msg, "%s", mpm_last_error());
+        mpm_clear_error();
+        return mpm_error(MPM_EINPUT, "%s: %s: %s", m->base, path, msg);
+    }
+    return MPM_OK;
+}
+
+/* "reference": {"solver", "eps", "solver_opts"} (false per scene: none). */
+static int get_reference(const Matrix *m, json_t *v, const char *path, int allow_false, MatrixReference *r)
+{
+    static const char *const keys[] = {"solver", "eps", "solver_opts", NULL};
+    memset(r, 0, sizeof *r);
+    snprintf(r->origin, sizeof r->origin, "%s", path);
+    if (allow_false && json_is_false(v)) return MPM_OK;
+    if (!json_is_object(v))
+        return bad_value(m, path, v, allow_false ? "an object {\"solver\": ...} or false" : "an object {\"solver\": ...}");
+    int st = check_keys(m, v, path, keys);
+    if (st) return st;
+    char p[300];
+    json_t *s = json_object_get(v, "solver");
+    join_path(p, sizeof p, path, "solver");
+    if (!s) return mpm_error(MPM_EINPUT, "%s: %s: missing (required)", m->base, p);
+    if ((st = get_solver(m, s, p, r->solver, sizeof r->solver))) return st;
+    r->eps = 1e-10;
+    json_t *e = json_object_get(v, "eps");
+    join_path(p, sizeof p, path, "eps");
+    if (e && (st = get_positive(m, e, p, &r->eps))) return st;
+    json_t *o = json_object_get(v, "solver_opts");
+    join_path(p, sizeof p, path, "solver_opts");
+    if (o && (st = get_kv(m, o, p, MATRIX_SOLVER_OPTS, &r->solver_opts))) return st;
+    r->has = 1;
+    return MPM_OK;
+}
+
+static int resolve_dir(const Matrix *m, const char *path, const char *given, char *out, size_t n)
+{
+    int w = given[0] == '/' ? snprintf(out, n, "%s", given) : snprintf(out, n, "%s/%s", m->dir, given);
+    if (w < 0 || (size_t)w >= n) return mpm_error(MPM_EINPUT, "%s: %s: path too long", m->base, path);
+    return MPM_OK;
+}
+
+/* The run limits and accuracy settings: shared by defaults and per-scene
+ * entries. Returns 1 when key is one of them (st set), else 0. */
+static int get_run_setting(Matrix *m, const char *key, json_t *v, const char *p, MatrixSettings *s, int *st)
+{
+    if (!strcmp(key, "error_ref")) {
+        *st = get_error_ref(m, v, p, s->error_ref, sizeof s->error_ref);
+        s->has_error_ref = 1;
+    } else if (!strcmp(key, "trajectory")) {
+        *st = get_bool(m, v, p, &s->trajectory);
+        s->has_trajectory = 1;
+    } else if (!strcmp(key, "max_outer") || !strcmp(key, "max_linear")) {
+        int outer = !strcmp(key, "max_outer");
+        *st = get_int(m, v, p, 1, outer ? &s->max_outer : &s->max_linear);
+        if (outer) s->has_max_outer = 1;
+        else s->has_max_linear = 1;
+    } else if (!strcmp(key, "max_step_seconds") || !strcmp(key, "max_run_seconds")) {
+        int step = !strcmp(key, "max_step_seconds");
+        double *dst = step ? &s->max_step_s : &s->max_run_s;
+        *st = get_positive(m, v, p, dst);
+        if (!*st && *dst > 1e9) *st = bad_value(m, p, v, "seconds in (0, 1e9]");
+        if (step) s->has_max_step_s = 1;
+        else s->has_max_run_s = 1;
+    } else if (!strcmp(key, "on_failure")) {
+        *st = get_string(m, v, p, s->on_failure, sizeof s->on_failure);
+        if (!*st && strcmp(s->on_failure, "stop") && strcmp(s->on_failure, "continue"))
+            *st = bad_value(m, p, v, "\"stop\" or \"continue\"");
+        s->has_on_failure = 1;
+    } else if (!strcmp(key, "reference")) {
+        *st = get_reference(m, v, p, 1, &s->reference);
+        s->has_reference = 1;
+    } else {
+        return 0;
+    }
+    return 1;
+}
+
+/* defaults (every key) or a per-scene entry (scale, frames, first_timed_frame,
+ * set, the run limits, error_ref, reference). */
+static int get_settings(Matrix *m, json_t *obj, const char *path, int per_scene, MatrixSettings *s)
+{
+    static const char *const all[] = {"scene",     "solver",     "eps",        "scale",           "threads",
+                                      "frames",    "first_timed_frame", "set", "solver_opts",     "history",
+                                      "armijo",    "particles",  "asset_dir",  "error_ref",       "trajectory",
+                                      "max_outer", "max_linear", "max_step_seconds", "max_run_seconds", "on_failure",
+                                      NULL};
+    static const char *const scene_keys[] = {"scale",      "frames",           "first_timed_frame", "set",
+                                             "error_ref",  "max_outer",        "max_linear",        "max_step_seconds",
+                                             "max_run_seconds", "on_failure",  "reference",         NULL};
+    if (!json_is_object(obj)) return bad_value(m, path, obj, "an object");
+    int st = check_keys(m, obj, path, per_scene ? scene_keys : all);
+    if (st) return st;
+    const char *key;
+    json_t *v;
+    json_object_foreach(obj, key, v) {
+        char p[256];
+        join_path(p, sizeof p, path, key);
+        if (get_run_setting(m, key, v, p, s, &st)) {
+            if (st) return st;
+            continue;
+        }
+        if (!strcmp(key, "scene")) {
+            st = get_scene(m, v, p, s->scene, sizeof s->scene);
+            snprintf(s->scene_origin, sizeof s->scene_origin, "%s", p);
+            s->has_scene = 1;
+        } else if (!strcmp(key, "solver")) {
+            st = get_solver(m, v, p, s->solver, sizeof s->solver);
+            snprintf(s->solver_origin, sizeof s->solver_origin, "%s", p);
+            s->has_solver = 1;
+        } else if (!strcmp(key, "eps")) {
+            st = get_positive(m, v, p, &s->eps);
+            s->has_eps = 1;
+        } else if (!strcmp(key, "scale")) {
+            st = get_positive(m, v, p, &s->scale);
+            s->has_scale = 1;
+        } else if (!strcmp(key, "threads")) {
+            st = get_int(m, v, p, 1, &s->threads);
+            s->has_threads = 1;
+        } else if (!strcmp(key, "frames")) {
+            st = get_int(m, v, p, 1, &s->frames);
+            s->has_frames = 1;
+        } else if (!strcmp(key, "first_timed_frame")) {
+            st = get_int(m, v, p, 0, &s->first_timed_frame);
+            s->has_first = 1;
+        } else if (!strcmp(key, "set")) {
+            st = get_kv(m, v, p, MATRIX_SET, &s->set);
+        } else if (!strcmp(key, "solver_opts")) {
+            st = get_kv(m, v, p, MATRIX_SOLVER_OPTS, &s->solver_opts);
+        } else if (!strcmp(key, "history")) {
+            st = get_bool(m, v, p, &s->history);
+            s->has_history = 1;
+        } else if (!strcmp(key, "armijo")) {
+            st = get_bool(m, v, p, &s->armijo);
+            s->has_armijo = 1;
+        } else if (!strcmp(key, "particles")) {
+            st = get_bool(m, v, p, &s->particles);
+            s->has_particles = 1;
+        } else if (!strcmp(key, "asset_dir")) {
+            char given[1024];
+            if (!(st = get_string(m, v, p, given, sizeof given))) st = resolve_dir(m, p, given, s->asset_dir, sizeof s->asset_dir);
+            s->has_asset_dir = 1;
+        }
+        if (st) return st;
+    }
+    if (s->has_frames && s->has_first && s->first_timed_frame >= s->frames) {
+        char p[256];
+        join_path(p, sizeof p, path, "first_timed_frame");
+        return bad_value(m, p, json_object_get(obj, "first_timed_frame"), "a frame before \"frames\"");
+    }
+    return MPM_OK;
+}
+
+/* A non-empty JSON array at path, or the error. */
+static int get_list(const Matrix *m, json_t *v, const char *path, size_t *n)
+{
+    if (!json_is_array(v)) return bad_value(m, path, v, "a list of values");
+    if (json_array_size(v) == 0)
+        return mpm_error(MPM_EINPUT, "%s: %s: empty list (an axis needs at least one value)", m->base, path);
+    *n = json_array_size(v);
+    return MPM_OK;
+}
+
+static int check_axis_name(const Matrix *m, const char *path, const char *name)
+{
+    int ok = name[0] >= 'a' && name[0] <= 'z' && strlen(name) < 64;
+    for (const char *c = name; *c && ok; ++c) ok = islower((unsigned char)*c) || isdigit((unsigned char)*c) || *c == '_';
+    if (!ok)
+        return mpm_error(MPM_EINPUT, "%s: %s: axis name \"%s\": expected [a-z][a-z0-9_]*, under 64 characters",
+                         m->base, path, name);
+    for (size_t i = 0; i < sizeof g_reserved / sizeof g_reserved[0]; ++i)
+        if (!strcmp(name, g_reserved[i]))
+            return mpm_error(MPM_EINPUT, "%s: %s: axis name \"%s\" is a built-in column name", m->base, path, name);
+    if (matrix_named_index(m, name) >= 0)
+        return mpm_error(MPM_EINPUT, "%s: %s: axis name \"%s\" is used twice", m->base, path, name);
+    return MPM_OK;
+}
+
+/* Label of a set given as a list element: its value for one key, else
+ * k=v;k=v. -1 when it does not fit. */
+static int auto_label(const MatrixKvList *kv, char *out, size_t n)
+{
+    if (kv->n == 1) return snprintf(out, n, "%s", kv->kv[0].value) < (int)n ? 0 : -1;
+    size_t len = 0;
+    out[0] = '\0';
+    for (int i = 0; i < kv->n; ++i) {
+        int w = snprintf(out + len, n - len, "%s%s=%s", i ? ";" : "", kv->kv[i].key, kv->kv[i].value);
+        if (w < 0 || (size_t)w >= n - len) return -1;
+        len += (size_t)w;
+    }
+    return 0;
+}
+
+static int get_named_axes(Matrix *m, json_t *obj, const char *path, MatrixNamedKind kind)
+{
+    if (!json_is_object(obj)) return bad_value(m, path, obj, "an object of named axes");
+    const char *name;
+    json_t *axis;
+    json_object_foreach(obj, name, axis) {
+        char ap[256];
+        join_path(ap, sizeof ap, path, name);
+        int st = check_axis_name(m, path, name);
+        if (st) return st;
+        if (m->n_named >= MATRIX_MAX_AXES)
+            return mpm_error(MPM_EINPUT, "%s: %s: more than %d named axes", m->base, path, MATRIX_MAX_AXES);
+        size_t n = 0;
+        if (json_is_object(axis)) {
+            n = json_object_size(axis);
+            if (!n) return mpm_error(MPM_EINPUT, "%s: %s: empty (an axis needs at least one value)", m->base, ap);
+        } else if ((st = get_list(m, axis, ap, &n))) {
+            return st;
+        }
+        MatrixNamedAxis *a = &m->named[m->n_named];
+        memset(a, 0, sizeof *a);
+        snprintf(a->name, sizeof a->name, "%s", name);
+        a->kind = kind;
+        if (!(a->values = calloc(n, sizeof *a->values))) return mpm_error(MPM_EINTERNAL, "out of memory");
+        m->n_named++;
+        if (json_is_object(axis)) {
+            const char *label;
+            json_t *set;
+            json_object_foreach(axis, label, set) {
+                char p[320];
+                snprintf(p, sizeof p, "%s.%s", ap, label);
+                if (!label[0] || strlen(label) >= sizeof a->values[0].label)
+                    return mpm_error(MPM_EINPUT, "%s: %s: bad label \"%s\"", m->base, ap, label);
+                snprintf(a->values[a->n].label, sizeof a->values[0].label, "%s", label);
+                if ((st = get_kv(m, set, p, kind, &a->values[a->n].kv))) return st;
+                a->n++;
+            }
+        } else {
+            for (size_t i = 0; i < n; ++i) {
+                char p[320];
+                snprintf(p, sizeof p, "%s[%zu]", ap, i);
+                if ((st = get_kv(m, json_array_get(axis, i), p, kind, &a->values[a->n].kv))) return st;
+                if (a->values[a->n].kv.n == 0)
+                    return bad_value(m, p, json_array_get(axis, i), "a non-empty set");
+                if (auto_label(&a->values[a->n].kv, a->values[a->n].label, sizeof a->values[0].label))
+                    return mpm_error(MPM_EINPUT, "%s: %s: label too long (give labels: {\"LABEL\": set})", m->base, p);
+                for (int k = 0; k < a->n; ++k)
+                    if (!strcmp(a->values[k].label, a->values[a->n].label))
+                        return mpm_error(MPM_EINPUT, "%s: %s: same label \"%s\" as %s[%d] (give labels: {\"LABEL\": set})",
+                                         m->base, p, a->values[a->n].label, ap, k);
+                a->n++;
+            }
+        }
+    }
+    return MPM_OK;
+}
+
+static int get_axes(Matrix *m, json_t *axes)
+{
+    static const char *const keys[] = {"scene", "solver", "eps", "scale", "threads", "error_ref", "sets", "solver_opts",
+                                       NULL};
+    if (!json_is_object(axes)) return bad_value(m, "axes", axes, "an object");
+    int st = check_keys(m, axes, "axes", keys);
+    if (st) return st;
+    json_t *v;
+    size_t n;
+    char p[64];
+    if ((v = json_object_get(axes, "scene"))) {
+        if ((st = get_list(m, v, "axes.scene", &n))) return st;
+        if (!(m->scenes = calloc(n, sizeof *m->scenes))) return mpm_error(MPM_EINTERNAL, "out of memory");
+        for (size_t i = 0; i < n; ++i, m->n_scenes++) {
+            snprintf(p, sizeof p, "axes.scene[%zu]", i);
+            if ((st = get_scene(m, json_array_get(v, i), p, m->scenes[i], sizeof m->scenes[i]))) return st;
+        }
+    }
+    if ((v = json_object_get(axes, "solver"))) {
+        if ((st = get_list(m, v, "axes.solver", &n))) return st;
+        if (!(m->solvers = calloc(n, sizeof *m->solvers))) return mpm_error(MPM_EINTERNAL, "out of memory");
+        for (size_t i = 0; i < n; ++i, m->n_solvers++) {
+            snprintf(p, sizeof p, "axes.solver[%zu]", i);
+            if ((st = get_solver(m, json_array_get(v, i), p, m->solvers[i], sizeof m->solvers[i]))) return st;
+        }
+    }
+    const char *num_keys[2] = {"eps", "scale"};
+    double **num_out[2] = {&m->eps, &m->scales};
+    int *num_n[2] = {&m->n_eps, &m->n_scales};
+    for (int k = 0; k < 2; ++k) {
+        if (!(v = json_object_get(axes, num_keys[k]))) continue;
+        snprintf(p, sizeof p, "axes.%s", num_keys[k]);
+        if ((st = get_list(m, v, p, &n))) return st;
+        if (!(*num_out[k] = calloc(n, sizeof(double)))) return mpm_error(MPM_EINTERNAL, "out of memory");
+        for (size_t i = 0; i < n; ++i, (*num_n[k])++) {
+            snprintf(p, sizeof p, "axes.%s[%zu]", num_keys[k], i);
+            if ((st = get_positive(m, json_array_get(v, i), p, &(*num_out[k])[i]))) return st;
+        }
+    }
+    if ((v = json_object_get(axes, "threads"))) {
+        if ((st = get_list(m, v, "axes.threads", &n))) return st;
+        if (!(m->threads = calloc(n, sizeof *m->threads))) return mpm_error(MPM_EINTERNAL, "out of memory");
+        for (size_t i = 0; i < n; ++i, m->n_threads++) {
+            snprintf(p, sizeof p, "axes.threads[%zu]", i);
+            if ((st = get_int(m, json_array_get(v, i), p, 1, &m->threads[i]))) return st;
+        }
+    }
+    if ((v = json_object_get(axes, "error_ref"))) {
+        if ((st = get_list(m, v, "axes.error_ref", &n))) return st;
+        if (!(m->error_refs = calloc(n, sizeof *m->error_refs))) return mpm_error(MPM_EINTERNAL, "out of memory");
+        for (size_t i = 0; i < n; ++i, m->n_error_refs++) {
+            snprintf(p, sizeof p, "axes.error_ref[%zu]", i);
+            if ((st = get_error_ref(m, json_array_get(v, i), p, m->error_refs[i], sizeof m->error_refs[i]))) return st;
+        }
+    }
+    if ((v = json_object_get(axes, "sets")) && (st = get_named_axes(m, v, "axes.sets", MATRIX_SET))) return st;
+    if ((v = json_object_get(axes, "solver_opts")) &&
+        (st = get_named_axes(m, v, "axes.solver_opts", MATRIX_SOLVER_OPTS)))
+        return st;
+    return MPM_OK;
+}
+
+int matrix_named_index(const Matrix *m, const char *name)
+{
+    for (int i = 0; i < m->n_named; ++i)
+        if (!strcmp(m->named[i].name, name)) return i;
+    return -1;
+}
+
+/* Does the matrix have `text` as a value of the string axis `key`? */
+static int has_string_value(const Matrix *m, const char *key, const char *text)
+{
+    if (!strcmp(key, "scene")) {
+        if (!m->n_scenes) return m->defaults.has_scene && !strcmp(m->defaults.scene, text);
+        for (int i = 0; i < m->n_scenes; ++i)
+            if (!strcmp(m->scenes[i], text)) return 1;
+        return 0;
+    }
+    if (!strcmp(key, "solver")) {
+        if (!m->n_solvers) return m->defaults.has_solver && !strcmp(m->defaults.solver, text);
+        for (int i = 0; i < m->n_solvers; ++i)
+            if (!strcmp(m->solvers[i], text)) return 1;
+        return 0;
+    }
+    if (!strcmp(key, "error_ref")) {
+        if (!m->n_error_refs) return m->defaults.has_error_ref && !strcmp(m->defaults.error_ref, text);
+        for (int i = 0; i < m->n_error_refs; ++i)
+            if (!strcmp(m->error_refs[i], text)) return 1;
+        return 0;
+    }
+    const MatrixNamedAxis *a = &m->named[matrix_named_index(m, key)];
+    for (int i = 0; i < a->n; ++i)
+        if (!strcmp(a->values[i].label, text)) return 1;
+    return 0;
+}
+
+/* One rule value: the right type, and a value the matrix has. */
+static int check_rule_value(const Matrix *m, const char *key, json_t *v, const char *path)
+{
+    if (!strcmp(key, "eps") || !strcmp(key, "scale")) {
+        double x;
+        return get_positive(m, v, path, &x);
+    }
+    if (!strcmp(key, "threads")) {
+        int t;
+        return get_int(m, v, path, 1, &t);
+    }
+    char text[256];
+    if (json_is_number(v) && strcmp(key, "scene") && strcmp(key, "solver") && strcmp(key, "error_ref"))
+        matrix_format_number(json_number_value(v), text, sizeof text);
+    else if (!json_is_string(v))
+        return bad_value(m, path, v, "a string (a value of that axis)");
+    else
+        snprintf(text, sizeof text, "%s", json_string_value(v));
+    if (!has_string_value(m, key, text))
+        return mpm_error(MPM_EINPUT, "%s: %s: \"%s\" is not a value of the matrix's %s", m->base, path, text, key);
+    return MPM_OK;
+}
+
+static int get_rules(Matrix *m, json_t *rules, const char *path)
+{
+    if (!json_is_array(rules)) return bad_value(m, path, rules, "a list of rules");
+    for (size_t i = 0; i < json_array_size(rules); ++i) {
+        json_t *r = json_array_get(rules, i);
+        char rp[64];
+        snprintf(rp, sizeof rp, "%s[%zu]", path, i);
+        if (!json_is_object(r) || !json_object_size(r)) return bad_value(m, rp, r, "a non-empty object {axis: value(s)}");
+        const char *key;
+        json_t *v;
+        json_object_foreach(r, key, v) {
+            char p[160];
+            snprintf(p, sizeof p, "%s.%s", rp, key);
+            static const char *const fixed[] = {"scene", "solver", "eps", "scale", "threads", "error_ref"};
+            int known = matrix_named_index(m, key) >= 0;
+            for (int k = 0; k < 6; ++k) known |= !strcmp(key, fixed[k]);
+            if (!known)
+                return mpm_error(MPM_EINPUT,
+                                 "%s: %s: unknown axis \"%s\" (scene, solver, eps, scale, threads, error_ref or a named axis)",
+                                 m->base, rp, key);
+            int st;
+            if (json_is_array(v)) {
+                if (!json_array_size(v)) return bad_value(m, p, v, "a value or a non-empty list");
+                for (size_t k = 0; k < json_array_size(v); ++k) {
+                    char q[192];
+                    snprintf(q, sizeof q, "%s[%zu]", p, k);
+                    if ((st = check_rule_value(m, key, json_array_get(v, k), q))) return st;
+                }
+            } else if ((st = check_rule_value(m, key, v, p))) {
+                return st;
+            }
+        }
+    }
+    return MPM_OK;
+}
+
+static int get_top(Matrix *m)
+{
+    static const char *const keys[] = {"name",     "description",    "defaults", "axes",      "scenes", "include",
+                                       "exclude",  "baseline",       "cell_timeout_s", "report", "reference", NULL};
+    json_t *root = m->root;
+    if (!json_is_object(root)) return bad_value(m, "(top level)", root, "an object");
+    int st = check_keys(m, root, "", keys);
+    if (st) return st;
+    json_t *v = json_object_get(root, "name");
+    if (!v) return mpm_error(MPM_EINPUT, "%s: name: missing (required)", m->base);
+    if ((st = get_string(m, v, "name", m->name, sizeof m->name))) return st;
+    for (const char *c = m->name; *c; ++c)
+        if (!isalnum((unsigned char)*c) && *c != '_' && *c != '-' && *c != '.')
+            return bad_value(m, "name", v, "1-63 of A-Z a-z 0-9 _ - .");
+    if ((v = json_object_get(root, "description"))) {
+        if (!json_is_string(v)) return bad_value(m, "description", v, "a string");
+        snprintf(m->description, sizeof m->description, "%s", json_string_value(v));
+    }
+    if ((v = json_object_get(root, "defaults")) && (st = get_settings(m, v, "defaults", 0, &m->defaults))) return st;
+    if ((v = json_object_get(root, "axes")) && (st = get_axes(m, v))) return st;
+    if (!m->n_scenes && !m->defaults.has_scene)
+        return mpm_error(MPM_EINPUT, "%s: axes.scene: missing (give axes.scene or defaults.scene)", m->base);
+    if (!m->n_solvers && !m->defaults.has_solver)
+        return mpm_error(MPM_EINPUT, "%s: axes.solver: missing (give axes.solver or defaults.solver)", m->base);
+    if ((v = json_object_get(root, "scenes"))) {
+        if (!json_is_object(v)) return bad_value(m, "scenes", v, "an object {scene: settings}");
+        if (!(m->per_scene = calloc(json_object_size(v) + 1, sizeof *m->per_scene)))
+            return mpm_error(MPM_EINTERNAL, "out of memory");
+        const char *scene;
+        json_t *s;
+        json_object_foreach(v, scene, s) {
+            char p[1100];
+            snprintf(p, sizeof p, "scenes.%s", scene);
+            if (!has_string_value(m, "scene", scene))
+                return mpm_error(MPM_EINPUT, "%s: %s: \"%s\" is not a scene of the matrix", m->base, p, scene);
+            MatrixSceneSettings *ps = &m->per_scene[m->n_per_scene++];
+            snprintf(ps->scene, sizeof ps->scene, "%s", scene);
+            if ((st = get_settings(m, s, p, 1, &ps->s))) return st;
+        }
+    }
+    if ((v = json_object_get(root, "reference")) && (st = get_reference(m, v, "reference", 0, &m->reference)))
+        return st;
+    m->has_references = m->reference.has;
+    m->uses_error_ref = m->defaults.has_error_ref || m->n_error_refs > 0;
+    for (int i = 0; i < m->n_per_scene; ++i) {
+        const MatrixSettings *ps = &m->per_scene[i].s;
+        m->uses_error_ref |= ps->has_error_ref;
+        m->has_references |= ps->has_reference && ps->reference.has;
+    }
+    if ((v = json_object_get(root, "include"))) {
+        if ((st = get_rules(m, v, "include"))) return st;
+        m->include = v;
+    }
+    if ((v = json_object_get(root, "exclude"))) {
+        if ((st = get_rules(m, v, "exclude"))) return st;
+        m->exclude = v;
+    }
+    if ((v = json_object_get(root, "baseline"))) {
+        if ((st = get_solver(m, v, "baseline", m->baseline, sizeof m->baseline))) return st;
+        if (!has_string_value(m, "solver", m->baseline))
+            return mpm_error(MPM_EINPUT, "%s: baseline: \"%s\" is not a solver of the matrix", m->base, m->baseline);
+    }
+    if ((v = json_object_get(root, "cell_timeout_s")) && (st = get_positive(m, v, "cell_timeout_s", &m->cell_timeout_s)))
+        return st;
+    if ((v = json_object_get(root, "report"))) {
+        static const char *const rk[] = {"mg_levels", NULL};
+        if (!json_is_object(v)) return bad_value(m, "report", v, "an object");
+        if ((st = check_keys(m, v, "report", rk))) return st;
+        json_t *g = json_object_get(v, "mg_levels");
+        if (g && (st = get_bool(m, g, "report.mg_levels", &m->report_mg_levels))) return st;
+    }
+    return MPM_OK;
+}
+
+int matrix_load(const char *path, Matrix *m)
+{
+    memset(m, 0, sizeof *m);
+    snprintf(m->file, sizeof m->file, "%s", path);
+    const char *slash = strrchr(path, '/');
+    snprintf(m->base, sizeof m->base, "%s", slash ? slash + 1 : path);
+    if (slash) snprintf(m->dir, sizeof m->dir, "%.*s", (int)(slash - path), path);
+    else snprintf(m->dir, sizeof m->dir, ".");
+    if (!m->dir[0]) snprintf(m->dir, sizeof m->dir, "/");
+    json_error_t err;
+    m->root = json_load_file(path, JSON_REJECT_DUPLICATES, &err);
+    if (!m->root) {
+        if (err.line > 0)
+            return mpm_error(MPM_EINPUT, "%s:%d:%d: malformed JSON: %s", path, err.line, err.column, err.text);
+        return mpm_error(MPM_EINPUT, "%s: cannot read matrix file: %s", path, err.text);
+    }
+    return get_top(m);
+}
+
+void matrix_free(Matrix *m)
+{
+    free(m->scenes);
+    free(m->solvers);
+    free(m->eps);
+    free(m->scales);
+    free(m->threads);
+    free(m->error_refs);
+    for (int i = 0; i < m->n_named; ++i) free(m->named[i].values);
+    free(m->per_scene);
+    json_decref(m->root);
+    memset(m, 0, sizeof *m);
+}

@@ -1,0 +1,460 @@
+/* `mpmbench render`. See render_cmd.h. */
+#include "experiments/render/render_cmd.h"
+
+#include <limits.h>
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "core/threads.h"
+#include "core/step.h"
+#include "experiments/run/progress.h"
+#include "experiments/run/registry.h"
+#include "experiments/render/render.h"
+#include "experiments/run/run.h"
+#include "solvers/solver.h"
+
+#define RC_MAX_SET 64
+#define RC_DEFAULT_LONG_SIDE 800
+#define RC_MIN_SHORT_SIDE 160
+#define RC_MAX_SIDE 16384
+#define RC_FRAME_SAMPLES 40 /* per axis, collider neighbourhood sampling */
+
+typedef struct {
+    const char *scene, *solver, *out, *asset_dir;
+    int frame, width, height, threads;
+    size_t max_particles;
+    double scale;
+    char view[8];
+    int color_by;
+    SceneOverride ov[RC_MAX_SET];
+    char ov_text[RC_MAX_SET][256];
+    int n_ov;
+} RenderArgs;
+
+/* ------------------------------------------------------------------ arguments */
+
+static int rc_int(const char *flag, const char *s, int lo, int *out)
+{
+    char *end = NULL;
+    long v = strtol(s, &end, 10);
+    if (!s[0] || *end || v < lo || v > 1000000000L)
+        return mpm_error(MPM_EINPUT, "%s '%s': expected an integer >= %d", flag, s, lo);
+    *out = (int)v;
+    return MPM_OK;
+}
+
+/* An image side in pixels: [1, RC_MAX_SIDE]. */
+static int rc_side(const char *flag, const char *s, int *out)
+{
+    char *end = NULL;
+    long v = strtol(s, &end, 10);
+    if (!s[0] || *end || v < 1 || v > RC_MAX_SIDE)
+        return mpm_error(MPM_EINPUT, "%s '%s': expected an image size in pixels in [1, %d]", flag, s, RC_MAX_SIDE);
+    *out = (int)v;
+    return MPM_OK;
+}
+
+static int rc_double(const char *flag, const char *s, double *out)
+{
+    char *end = NULL;
+    double v = strtod(s, &end);
+    if (!s[0] || *end || !isfinite(v) || !(v > 0))
+        return mpm_error(MPM_EINPUT, "%s '%s': expected a positive number", flag, s);
+    *out = v;
+    return MPM_OK;
+}
+
+static int parse_render_args(int argc, char **argv, RenderArgs *a)
+{
+    memset(a, 0, sizeof *a);
+    a->solver = "pn-pcg";
+    a->scale = 1.0;
+    strcpy(a->view, "front");
+    int st;
+    for (int i = 2; i < argc; ++i) {
+        const char *f = argv[i];
+        if (strncmp(f, "--", 2)) return mpm_error(MPM_EINPUT, "render: unexpected argument '%s'", f);
+        if (i + 1 >= argc) {
+            if (!strcmp(f, "--scene") || !strcmp(f, "--frame") || !strcmp(f, "--out") || !strcmp(f, "--solver") ||
+                !strcmp(f, "--scale") || !strcmp(f, "--set") || !strcmp(f, "--view") || !strcmp(f, "--color") ||
+                !strcmp(f, "--width") || !strcmp(f, "--height") || !strcmp(f, "--asset-dir") ||
+                !strcmp(f, "--threads") || !strcmp(f, "--max-particles"))
+                return mpm_error(MPM_EINPUT, "%s: missing value", f);
+            return mpm_error(MPM_EINPUT, "render: unknown option '%s' (see: mpmbench --help)", f);
+        }
+        const char *v = argv[++i];
+        if (!strcmp(f, "--scene")) a->scene = v;
+        else if (!strcmp(f, "--solver")) a->solver = v;
+        else if (!strcmp(f, "--out")) a->out = v;
+        else if (!strcmp(f, "--asset-dir")) a->asset_dir = v;
+        else if (!strcmp(f, "--frame")) { if ((st = rc_int(f, v, 0, &a->frame))) return st; }
+        else if (!strcmp(f, "--width")) { if ((st = rc_side(f, v, &a->width))) return st; }
+        else if (!strcmp(f, "--height")) { if ((st = rc_side(f, v, &a->height))) return st; }
+        else if (!strcmp(f, "--threads")) { if ((st = threads_parse(f, v, &a->threads))) return st; }
+        else if (!strcmp(f, "--max-particles")) { if ((st = scene_parse_particle_budget(f, v, &a->max_particles))) return st; }
+        else if (!strcmp(f, "--scale")) { if ((st = rc_double(f, v, &a->scale))) return st; }
+        else if (!strcmp(f, "--view")) {
+            if (strcmp(v, "front") && strcmp(v, "side") && strcmp(v, "top") && strcmp(v, "iso"))
+                return mpm_error(MPM_EINPUT, "--view '%s': expected front, side, top or iso", v);
+            strcpy(a->view, v);
+        } else if (!strcmp(f, "--color")) {
+            if (!strcmp(v, "material")) a->color_by = 0;
+            else if (!strcmp(v, "speed")) a->color_by = 1;
+            else return mpm_error(MPM_EINPUT, "--color '%s': expected material or speed", v);
+        } else if (!strcmp(f, "--set")) {
+            if (a->n_ov >= RC_MAX_SET) return mpm_error(MPM_EINPUT, "too many --set options");
+            const char *eq = strchr(v, '=');
+            if (!eq || eq == v) return mpm_error(MPM_EINPUT, "--set '%s': expected key=value", v);
+            if (strlen(v) + 1 > sizeof a->ov_text[0]) return mpm_error(MPM_EINPUT, "--set '%s': too long", v);
+            char *s = a->ov_text[a->n_ov];
+            strcpy(s, v);
+            s[eq - v] = '\0';
+            a->ov[a->n_ov].key = s;
+            a->ov[a->n_ov].value = s + (eq - v) + 1;
+            a->n_ov++;
+        } else
+            return mpm_error(MPM_EINPUT, "render: unknown option '%s' (see: mpmbench --help)", f);
+    }
+    if (!a->scene) return mpm_error(MPM_EINPUT, "render: --scene is required");
+    if (a->out && !a->out[0]) return mpm_error(MPM_EINPUT, "--out: empty file name");
+    return MPM_OK;
+}
+
+/* ------------------------------------------------------------------ colliders */
+
+/* The domain walls the scene loader adds (core/scene/scene_load.c add_walls). */
+static int is_domain_wall(const Collider *c)
+{
+    static const char *const names[] = {"wall_x_min", "wall_x_max", "wall_y_min",
+                                        "wall_y_max", "wall_z_min", "wall_z_max"};
+    if (strcmp(shape_type_name(c->shape), "half_space")) return 0;
+    for (size_t k = 0; k < sizeof names / sizeof names[0]; ++k)
+        if (!strcmp(c->name, names[k])) return 1;
+    return 0;
+}
+
+/* Vertical half-spaces (side walls, e.g. Boxes and Boards) would cover the
+ * whole picture as huge planes: only floors (normal near +-y) are drawn. */
+static int is_side_wall(const Scene *sc, const Collider *c, double t)
+{
+    if (strcmp(shape_type_name(c->shape), "half_space")) return 0;
+    double x[3], n[3] = {0, 1, 0};
+    for (int d = 0; d < 3; ++d) x[d] = 0.5 * (sc->domain_lo[d] + sc->domain_hi[d]);
+    collider_phi(c, t, x, n);
+    return fabs(n[1]) < 0.9;
+}
+
+typedef struct {
+    const Scene *sc;
+    double t;
+    const int *idx; /* drawn collider -> scene collider */
+} SdfCtx;
+
+static double sdf_cb(const void *ctx, int i, const double x[3])
+{
+    const SdfCtx *s = ctx;
+    return collider_phi(&s->sc->colliders[s->idx[i]], s->t, x, NULL);
+}
+
+static double box_distance(const double p[3], const double lo[3], const double hi[3])
+{
+    double d2 = 0;
+    for (int d = 0; d < 3; ++d) {
+        double e = p[d] < lo[d] ? lo[d] - p[d] : (p[d] > hi[d] ? p[d] - hi[d] : 0);
+        d2 += e * e;
+    }
+    return sqrt(d2);
+}
+
+static void grow(double lo[3], double hi[3], const double p[3])
+{
+    for (int d = 0; d < 3; ++d) {
+        lo[d] = fmin(lo[d], p[d]);
+        hi[d] = fmax(hi[d], p[d]);
+    }
+}
+
+/* Grows [lo, hi] (the particles' box on entry) by the drawn colliders'
+ * surfaces near it; see render_cmd.h. Surface samples: the points of a
+ * regular grid over the neighbourhood whose |phi| is within half a cell
+ * diagonal (phi is a distance or a lower bound of one, so every surface
+ * point near the grid has such a sample).
+ * With `empty` set (no particles), the neighbourhood is the domain, [lo, hi]
+ * becomes the box of the bounded colliders' surfaces in it, and stays as it
+ * was (the domain) when there are none. */
+static int frame_colliders(const Scene *sc, double t, const int *idx, int n, int empty, double lo[3], double hi[3])
+{
+    double plo[3], phi_[3], ext = 0;
+    for (int d = 0; d < 3; ++d) {
+        plo[d] = lo[d];
+        phi_[d] = hi[d];
+        ext = fmax(ext, hi[d] - lo[d]);
+    }
+    if (!(ext > 0)) ext = 10 * sc->dx;
+    const double pad = empty ? 0.0 : ext;
+    const int G = RC_FRAME_SAMPLES;
+    double nlo[3], cell[3], diag = 0;
+    for (int d = 0; d < 3; ++d) {
+        nlo[d] = plo[d] - pad;
+        cell[d] = (phi_[d] - plo[d] + 2 * pad) / (G - 1);
+        diag += cell[d] * cell[d];
+    }
+    double tol = 0.5 * sqrt(diag);
+    size_t npts = (size_t)G * G * G;
+    double *dist = malloc(npts * sizeof *dist); /* distance to the particle box of surface samples, else -1 */
+    if (!dist) return mpm_error(MPM_EINTERNAL, "render: out of memory framing colliders");
+    double glo[3] = {INFINITY, INFINITY, INFINITY}, ghi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    if (!empty) {
+        memcpy(glo, plo, sizeof glo);
+        memcpy(ghi, phi_, sizeof ghi);
+    }
+    for (int c = 0; c < n; ++c) {
+        const Collider *col = &sc->colliders[idx[c]];
+        int bounded = shape_is_bounded(col->shape);
+        if (empty && !bounded) continue;
+        double dmin = INFINITY;
+#pragma omp parallel for reduction(min : dmin) schedule(static)
+        for (long k = 0; k < (long)npts; ++k) {
+            double p[3] = {nlo[0] + cell[0] * (double)(k % G), nlo[1] + cell[1] * (double)((k / G) % G),
+                           nlo[2] + cell[2] * (double)(k / ((long)G * G))};
+            double f = collider_phi(col, t, p, NULL);
+            if (isfinite(f) && fabs(f) <= tol) {
+                dist[k] = box_distance(p, plo, phi_);
+                dmin = fmin(dmin, dist[k]);
+            } else {
+                dist[k] = -1;
+            }
+        }
+        double limit = bounded ? INFINITY : dmin + 0.1 * ext + tol;
+        for (size_t k = 0; k < npts; ++k) {
+            if (dist[k] < 0 || dist[k] > limit) continue;
+            double p[3] = {nlo[0] + cell[0] * (double)(k % G), nlo[1] + cell[1] * (double)((k / G) % G),
+                           nlo[2] + cell[2] * (double)(k / ((size_t)G * G))};
+            grow(glo, ghi, p);
+        }
+    }
+    free(dist);
+    if (glo[0] <= ghi[0]) {
+        memcpy(lo, glo, sizeof glo);
+        memcpy(hi, ghi, sizeof ghi);
+    }
+    return MPM_OK;
+}
+
+/* ------------------------------------------------------------------ image size */
+
+static void view_axes(const char *view, double right[3], double up[3])
+{
+    static const double a = 0.70710678118654752, b = 0.40824829046386302;
+    const double *r, *u;
+    static const double fr[3] = {1, 0, 0}, fu[3] = {0, 1, 0}, sr[3] = {0, 0, -1}, tu[3] = {0, 0, -1};
+    static const double ir[3] = {a, 0, -a}, iu[3] = {-b, 2 * b, -b};
+    if (!strcmp(view, "side")) { r = sr; u = fu; }
+    else if (!strcmp(view, "top")) { r = fr; u = tu; }
+    else if (!strcmp(view, "iso")) { r = ir; u = iu; }
+    else { r = fr; u = fu; }
+    memcpy(right, r, 3 * sizeof *r);
+    memcpy(up, u, 3 * sizeof *u);
+}
+
+static void image_size(const RenderArgs *a, const double lo[3], const double hi[3], int *W, int *H)
+{
+    double right[3], up[3];
+    view_axes(a->view, right, up);
+    double umin = INFINITY, umax = -INFINITY, vmin = INFINITY, vmax = -INFINITY;
+    for (int k = 0; k < 8; ++k) {
+        double c[3] = {k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]};
+        double u = c[0] * right[0] + c[1] * right[1] + c[2] * right[2];
+        double v = c[0] * up[0] + c[1] * up[1] + c[2] * up[2];
+        umin = fmin(umin, u);
+        umax = fmax(umax, u);
+        vmin = fmin(vmin, v);
+        vmax = fmax(vmax, v);
+    }
+    double aspect = (umax - umin) / (vmax - vmin); /* width / height */
+    if (!isfinite(aspect) || !(aspect > 0)) aspect = 1;
+    int w = a->width, h = a->height;
+    if (!w && !h) {
+        if (aspect >= 1) {
+            w = RC_DEFAULT_LONG_SIDE;
+            h = (int)lround(w / aspect);
+        } else {
+            h = RC_DEFAULT_LONG_SIDE;
+            w = (int)lround(h * aspect);
+        }
+        if (w < RC_MIN_SHORT_SIDE) w = RC_MIN_SHORT_SIDE;
+        if (h < RC_MIN_SHORT_SIDE) h = RC_MIN_SHORT_SIDE;
+    } else if (!h) {
+        double hh = w / aspect;
+        h = hh < 1 ? 1 : (hh > RC_MAX_SIDE ? RC_MAX_SIDE : (int)lround(hh));
+    } else if (!w) {
+        double ww = h * aspect;
+        w = ww < 1 ? 1 : (ww > RC_MAX_SIDE ? RC_MAX_SIDE : (int)lround(ww));
+    }
+    *W = w;
+    *H = h;
+}
+
+/* ------------------------------------------------------------------ simulation */
+
+typedef struct {
+    Progress *progress;
+    int frame, step;
+    double fraction;
+} RcHook;
+
+static void rc_hook(void *ctx, int iter, double elapsed, double residual, double energy)
+{
+    (void)energy;
+    RcHook *h = ctx;
+    progress_update(h->progress, h->fraction, h->frame, h->step, iter, residual, elapsed);
+}
+
+/* Advances sim by `frames` frames with the solver; *worst gets the worst
+ * SolveStatus seen. */
+static int simulate(Simulation *sim, Solver *solver, int frames, int *worst)
+{
+    int status = MPM_OK;
+    StepWork work = {.dv = NULL, .cap = 0};
+    Progress prog;
+    progress_init(&prog, frames);
+    SolveSettings set;
+    solve_settings_default(&set);
+    RcHook hook = {&prog, 0, 0, 0.0};
+    *worst = SOLVE_CONVERGED;
+    while (sim->frame < frames) {
+        int frame = sim->frame, step = 0;
+        while (sim->frame == frame) {
+            hook.frame = frame;
+            hook.step = step;
+            hook.fraction = (frame + sim->t_in_frame / sim->frame_dt) / frames;
+            SolveStats ss;
+            StepInfo si;
+            if ((status = run_step(sim, solver, &set, &work, rc_hook, &hook, 0, &ss, &si))) goto done;
+            if ((int)ss.status > *worst) *worst = ss.status;
+            if (!si.advanced) {
+                status = mpm_error(MPM_EINTERNAL, "frame %d step %d failed: %s", frame, step, ss.reason);
+                goto done;
+            }
+            ++step;
+        }
+        progress_clear(&prog);
+    }
+done:
+    progress_clear(&prog);
+    free(work.dv);
+    return status;
+}
+
+/* ------------------------------------------------------------------ command */
+
+static int render_state(const RenderArgs *a, const Scene *sc, const Particles *p, double t, const char *path)
+{
+    if (p->n > (size_t)INT_MAX) return mpm_error(MPM_EINPUT, "render: too many particles (%zu)", p->n);
+    int n = (int)p->n;
+    int status = MPM_OK;
+    int *idx = malloc((size_t)(sc->n_colliders > 0 ? sc->n_colliders : 1) * sizeof *idx);
+    double *speed = NULL;
+    if (!idx) return mpm_error(MPM_EINTERNAL, "render: out of memory");
+    int n_draw = 0;
+    for (int c = 0; c < sc->n_colliders; ++c)
+        if (!is_domain_wall(&sc->colliders[c]) && !is_side_wall(sc, &sc->colliders[c], t) &&
+            collider_active(&sc->colliders[c], t))
+            idx[n_draw++] = c;
+
+    /* framed box: finite particles, then the colliders near them */
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    int n_finite = 0;
+    for (int i = 0; i < n; ++i) {
+        const double *x = p->x + 3 * (size_t)i;
+        if (!isfinite(x[0]) || !isfinite(x[1]) || !isfinite(x[2])) continue;
+        ++n_finite;
+        grow(lo, hi, x);
+    }
+    if (n_finite == 0) { /* no particles (yet): the colliders in the domain, else the domain */
+        memcpy(lo, sc->domain_lo, sizeof lo);
+        memcpy(hi, sc->domain_hi, sizeof hi);
+    }
+    if (n_draw > 0 && (status = frame_colliders(sc, t, idx, n_draw, n_finite == 0, lo, hi))) goto done;
+    double ext = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+    if (!(ext > 0)) ext = 10 * sc->dx;
+    for (int d = 0; d < 3; ++d) {
+        double margin = fmax(0.1 * (hi[d] - lo[d]), 0.05 * ext);
+        lo[d] -= margin;
+        hi[d] += margin;
+    }
+
+    RenderOptions ro;
+    memset(&ro, 0, sizeof ro);
+    image_size(a, lo, hi, &ro.width, &ro.height);
+    memcpy(ro.view, a->view, sizeof ro.view);
+    ro.color_by = a->color_by;
+    memcpy(ro.lo, lo, sizeof lo);
+    memcpy(ro.hi, hi, sizeof hi);
+    if (a->color_by == 1) {
+        speed = malloc((size_t)(n > 0 ? n : 1) * sizeof *speed);
+        if (!speed) {
+            status = mpm_error(MPM_EINTERNAL, "render: out of memory");
+            goto done;
+        }
+        for (int i = 0; i < n; ++i) {
+            const double *v = p->v + 3 * (size_t)i;
+            speed[i] = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        }
+        ro.scalar = speed;
+    }
+    SdfCtx ctx = {sc, t, idx};
+    status = render_png(path, n, p->x, p->mat, sc->n_materials, n_draw, sdf_cb, &ctx, &ro);
+    if (!status) printf("wrote %s (%dx%d, %s view, t = %.4g s, %d particles)\n", path, ro.width, ro.height, a->view, t, n);
+done:
+    free(speed);
+    free(idx);
+    return status;
+}
+
+int render_command(int argc, char **argv)
+{
+    static RenderArgs a;
+    int status = parse_render_args(argc, argv, &a);
+    if (status) return status;
+    Solver *solver = NULL;
+    if ((status = solver_from_spec(a.solver, NULL, 0, &solver))) return status;
+    if (a.threads > 0) omp_set_num_threads(a.threads);
+
+    Scene scene;
+    SceneLoadOptions lo = {.scale = a.scale, .overrides = a.ov, .n_overrides = a.n_ov, .asset_dir = a.asset_dir,
+                           .max_particles = a.max_particles};
+    if ((status = scene_load(a.scene, &lo, &scene))) {
+        solver_destroy(solver);
+        return status;
+    }
+    char path[1100];
+    if (a.out) snprintf(path, sizeof path, "%s", a.out);
+    else snprintf(path, sizeof path, "%s.png", scene.name);
+
+    if (a.frame == 0) {
+        status = render_state(&a, &scene, &scene.particles, 0.0, path);
+        solver_destroy(solver);
+        scene_free(&scene);
+        return status;
+    }
+
+    Simulation sim;
+    memset(&sim, 0, sizeof sim);
+    int worst = SOLVE_CONVERGED;
+    if ((status = sim_init(&sim, &scene))) goto done;
+    if ((status = simulate(&sim, solver, a.frame, &worst))) goto done;
+    if (worst != SOLVE_CONVERGED)
+        fprintf(stderr, "mpmbench: warning: some steps did not converge (worst status %s)\n",
+                solve_status_name((SolveStatus)worst));
+    status = render_state(&a, &scene, &sim.p, sim.t, path);
+done:
+    sim_free(&sim);
+    solver_destroy(solver);
+    scene_free(&scene);
+    return status;
+}

@@ -1,0 +1,26 @@
+#include "experiments/run/library_startup.h"
+
+#include <omp.h>
+
+#include "adapters/cholmod.h"
+#include "adapters/boomeramg.h"
+#include "core/error.h"
+
+static double g_startup_s = 0.0;
+
+int library_startup(const Solver *solver)
+{
+    double t0 = omp_get_wtime();
+    int st = MPM_OK;
+    /* the first parallel region creates the thread team */
+#pragma omp parallel
+    {
+    }
+    const InvApproxOps *inv = solver && solver->inv ? solver->inv->ops : NULL;
+    if (inv == &inv_boomeramg_ops) st = boomeramg_library_startup();
+    if (!st && inv == &inv_cholmod_ops) st = cholmod_library_startup();
+    g_startup_s += omp_get_wtime() - t0;
+    return st;
+}
+
+double library_startup_seconds(void) { return g_startup_s; }

@@ -1,0 +1,432 @@
+#include "experiments/run/run.h"
+
+#include <errno.h>
+#include <jansson.h>
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "core/error.h"
+#include "core/step.h"
+#include "experiments/run/library_startup.h"
+#include "experiments/run/paths.h"
+#include "experiments/run/ply.h"
+#include "experiments/run/progress.h"
+#include "experiments/run/provenance.h"
+#include "experiments/run/registry.h"
+#include "experiments/accuracy/run_accuracy.h"
+#include "solvers/solver.h"
+
+#define RUN_MAX_SOLVER_OPTS 70
+
+void run_config_default(RunConfig *c)
+{
+    memset(c, 0, sizeof *c);
+    c->eps = 1e-7;
+    c->scale = 1.0;
+}
+
+void run_solve_settings(const RunConfig *cfg, SolveSettings *set)
+{
+    solve_settings_default(set);
+    set->eps = cfg->eps;
+    if (cfg->max_outer > 0) set->max_outer = cfg->max_outer;
+    if (cfg->max_linear > 0) set->max_linear = cfg->max_linear;
+}
+
+/* The user's solver options, plus linesearch=armijo for --armijo. */
+static int solver_option_list(const RunConfig *cfg, const char **list)
+{
+    int n = 0;
+    if (cfg->armijo) list[n++] = "linesearch=armijo";
+    for (int i = 0; i < cfg->n_solver_opts && n < RUN_MAX_SOLVER_OPTS; ++i) list[n++] = cfg->solver_opts[i];
+    return n;
+}
+
+static AccuracyConfig accuracy_config(const RunConfig *cfg)
+{
+    AccuracyConfig a = {cfg->error_ref, cfg->dt_from, cfg->trajectory_ref, cfg->trajectory};
+    return a;
+}
+
+static int check_seconds(const char *flag, double v)
+{
+    if (!(v >= 0.0) || !isfinite(v)) return mpm_error(MPM_EINPUT, "%s %g: expected a number of seconds >= 0", flag, v);
+    return MPM_OK;
+}
+
+int run_config_check(const RunConfig *cfg)
+{
+    int st;
+    if (!cfg->scene || !cfg->scene[0]) return mpm_error(MPM_EINPUT, "run: --scene is required");
+    if (!cfg->solver) return mpm_error(MPM_EINPUT, "run: --solver is required");
+    if (!(cfg->scale > 0.0) || !isfinite(cfg->scale))
+        return mpm_error(MPM_EINPUT, "--scale %g: expected a positive number", cfg->scale);
+    if (cfg->max_outer < 0) return mpm_error(MPM_EINPUT, "--max-outer %d: expected >= 1", cfg->max_outer);
+    if (cfg->max_linear < 0) return mpm_error(MPM_EINPUT, "--max-linear %d: expected >= 1", cfg->max_linear);
+    if ((st = check_seconds("--max-step-seconds", cfg->max_step_s))) return st;
+    if ((st = check_seconds("--max-run-seconds", cfg->max_run_s))) return st;
+    if (cfg->on_failure != RUN_STOP && cfg->on_failure != RUN_CONTINUE)
+        return mpm_error(MPM_EINPUT, "on_failure %d: expected stop or continue", (int)cfg->on_failure);
+    SolveSettings set;
+    run_solve_settings(cfg, &set);
+    if ((st = solve_settings_check(&set))) return st;
+    if ((st = paths_check_output_dir("--out", cfg->out_dir))) return st;
+    if ((st = paths_check_output_dir("--particles", cfg->particles_dir))) return st;
+    AccuracyConfig acc = accuracy_config(cfg);
+    if ((st = run_accuracy_check(&acc))) return st;
+    const char *opts[RUN_MAX_SOLVER_OPTS];
+    int n = solver_option_list(cfg, opts);
+    return solver_spec_check(cfg->solver, opts, n);
+}
+
+static FILE *open_in(const char *dir, const char *name, int *status)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "w");
+    if (!f) *status = mpm_error(MPM_EINPUT, "%s: cannot write", path);
+    return f;
+}
+
+/* A CSV field: quoted, inner quotes doubled, line breaks as spaces (RFC 4180). */
+static void csv_text(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; ++s) {
+        if (*s == '"') fputc('"', f);
+        fputc(*s == '\n' || *s == '\r' ? ' ' : *s, f);
+    }
+    fputc('"', f);
+}
+
+typedef struct {
+    FILE *iters;
+    Progress *progress;
+    int frame, step;
+    double fraction;
+} HookCtx;
+
+static void iter_hook(void *ctx, int iter, double elapsed, double residual, double energy)
+{
+    HookCtx *h = ctx;
+    if (h->iters)
+        fprintf(h->iters, "%d,%d,%d,%.6e,%.9e,%.12e\n", h->frame, h->step, iter, elapsed, residual, energy);
+    progress_update(h->progress, h->fraction, h->frame, h->step, iter, residual, elapsed);
+}
+
+/* Records the exact configuration beside the tables, so every number says
+ * how it was made (jansson escapes every string). */
+static void write_run_json(const char *dir, const RunConfig *cfg, const Scene *sc, const Solver *solver,
+                           const SolveSettings *set, const RunAccuracy *acc, int frames, int threads, int *status)
+{
+    AccuracyConfig ac = accuracy_config(cfg);
+    const SolverOptions *so = &solver->opts;
+    json_t *opts = json_object(), *ovr = json_object();
+    /* every option the solver consulted, with the value in effect (given or default) */
+    for (int i = 0; i < so->n_asked; ++i) json_object_set_new(opts, so->asked[i], json_string(so->asked_value[i]));
+    for (int i = 0; i < cfg->n_overrides; ++i)
+        json_object_set_new(ovr, cfg->overrides[i].key, json_string(cfg->overrides[i].value));
+    json_t *limits = json_pack("{s:i, s:i, s:f, s:f, s:s}", "max_outer", set->max_outer, "max_linear", set->max_linear,
+                               "max_step_seconds", cfg->max_step_s, "max_run_seconds", cfg->max_run_s, "on_failure",
+                               cfg->on_failure == RUN_CONTINUE ? "continue" : "stop");
+    json_t *root = json_pack("{s:s, s:s, s:s, s:s, s:s, s:o, s:o, s:f, s:f, s:f, s:i, s:i, s:s, s:o, s:I}", "scene",
+                             sc->name, "scene_path", sc->path, "solver", cfg->solver, "outer_method",
+                             solver->outer->ops->name, "inverse_approximation", solver->inv->ops->name,
+                             "solver_options", opts, "overrides", ovr, "eps", cfg->eps, "scale", cfg->scale, "dx",
+                             sc->dx, "frames", frames, "threads", threads, "line_search", solver->ls->name, "limits",
+                             limits, "particles", (json_int_t)sc->particles.n);
+    if (root) json_object_set_new(root, "accuracy", (json_t *)run_accuracy_json(&ac, acc));
+    if (root) json_object_set_new(root, "startup_s", json_real(library_startup_seconds()));
+    if (root) json_object_set_new(root, "provenance", provenance_json(threads, 0));
+    char path[1200];
+    snprintf(path, sizeof path, "%s/run.json", dir);
+    if (!root || json_dump_file(root, path, JSON_INDENT(2) | JSON_PRESERVE_ORDER) != 0)
+        *status = mpm_error(MPM_EINPUT, "%s: cannot write", path);
+    json_decref(root);
+}
+
+/* A numerical breakdown outside the solver: the step's failed status. */
+static int breakdown(int status, SolveStats *ss)
+{
+    if (status != MPM_ENUMERIC) return status;
+    ss->status = SOLVE_FAILED;
+    snprintf(ss->reason, sizeof ss->reason, "%s", mpm_last_error());
+    mpm_clear_error();
+    return MPM_OK;
+}
+
+int run_step(Simulation *sim, Solver *solver, const SolveSettings *set, StepWork *w, IterHook hook, void *hook_ctx,
+             int apply_failed, SolveStats *ss, StepInfo *info)
+{
+    int status;
+    memset(ss, 0, sizeof *ss);
+    memset(info, 0, sizeof *info);
+    double t0 = omp_get_wtime();
+    info->t = sim->t;
+    status = step_begin(sim);
+    double t1 = omp_get_wtime();
+    info->begin_s = t1 - t0;
+    info->dt = sim->dt;
+    if (status) {
+        info->wall_s = info->begin_s;
+        return breakdown(status, ss);
+    }
+    info->t = sim->t;
+    int n = sim->pb.n_nodes;
+    info->active_nodes = n;
+    if (n > w->cap) {
+        int cap = n + n / 4 + 256;
+        double *q = realloc(w->dv, sizeof(double) * 3 * (size_t)cap);
+        if (!q) return mpm_error(MPM_EINTERNAL, "out of memory: dv (%d nodes)", n);
+        w->dv = q;
+        w->cap = cap;
+    }
+    problem_initial_guess(&sim->pb, w->dv);
+    if ((status = solver_solve(solver, &sim->pb, set, w->dv, ss, hook, hook_ctx))) return status;
+    double t2 = omp_get_wtime();
+    if (ss->status != SOLVE_FAILED || apply_failed) {
+        if (w->after_solve) {
+            if ((status = w->after_solve(w->after_solve_ctx, &sim->pb, w->dv))) return status;
+            info->after_solve_s = omp_get_wtime() - t2;
+        }
+        SolveStats end = {0};
+        status = breakdown(step_end(sim, w->dv), &end);
+        if (status) return status;
+        if (end.status == SOLVE_FAILED) {
+            ss->status = SOLVE_FAILED;
+            snprintf(ss->reason, sizeof ss->reason, "%s", end.reason);
+        } else {
+            info->advanced = 1;
+        }
+    }
+    double t3 = omp_get_wtime();
+    info->wall_s = t3 - t0 - info->after_solve_s;
+    info->end_s = t3 - t2 - info->after_solve_s;
+    return MPM_OK;
+}
+
+static int worse(int a, int b) { return a > b ? a : b; } /* SolveStatus is ordered by severity */
+
+/* The deadline of the next solve: the earlier of the step's and the run's. */
+static void set_deadline(const RunConfig *cfg, double run_t0, SolveSettings *set, char *why, size_t len)
+{
+    double now = omp_get_wtime();
+    set->deadline = 0.0;
+    set->deadline_reason = why;
+    why[0] = '\0';
+    if (cfg->max_step_s > 0) {
+        set->deadline = now + cfg->max_step_s;
+        snprintf(why, len, "--max-step-seconds %g", cfg->max_step_s);
+    }
+    if (cfg->max_run_s > 0 && (set->deadline == 0.0 || run_t0 + cfg->max_run_s < set->deadline)) {
+        set->deadline = run_t0 + cfg->max_run_s;
+        snprintf(why, len, "--max-run-seconds %g", cfg->max_run_s);
+    }
+}
+
+int run_simulation(const RunConfig *cfg, RunSummary *sum)
+{
+    int status = MPM_OK;
+    memset(sum, 0, sizeof *sum);
+    /* every input checked before any work: the solver is created first */
+    if ((status = run_config_check(cfg))) return status;
+    const char *solver_opts[RUN_MAX_SOLVER_OPTS];
+    int n_solver_opts = solver_option_list(cfg, solver_opts);
+    Solver *solver = NULL;
+    if ((status = solver_from_spec(cfg->solver, solver_opts, n_solver_opts, &solver))) return status;
+    SolveSettings set;
+    run_solve_settings(cfg, &set);
+    if (cfg->threads > 0) omp_set_num_threads(cfg->threads);
+    int threads = omp_get_max_threads();
+    /* MPI, hypre, CHOLMOD, the thread team: started (and timed) here, not in the first step */
+    AccuracyConfig acfg = accuracy_config(cfg);
+    RunAccuracy acc;
+    memset(&acc, 0, sizeof acc);
+    if ((status = library_startup(solver)) || (status = run_accuracy_create(&acfg, &acc))) {
+        run_accuracy_free(&acc);
+        solver_destroy(solver);
+        return status;
+    }
+
+    Scene scene;
+    SceneLoadOptions lo = {.scale = cfg->scale, .overrides = cfg->overrides, .n_overrides = cfg->n_overrides,
+                           .asset_dir = cfg->asset_dir, .max_particles = cfg->max_particles};
+    if ((status = scene_load(cfg->scene, &lo, &scene))) {
+        run_accuracy_free(&acc);
+        solver_destroy(solver);
+        return status;
+    }
+    int frames = cfg->frames > 0 ? cfg->frames : scene.frames;
+    /* the reference runs match this scene: checked before the output folder is made */
+    if ((status = run_accuracy_bind(&acfg, &scene, frames, &acc))) {
+        run_accuracy_free(&acc);
+        solver_destroy(solver);
+        scene_free(&scene);
+        return status;
+    }
+
+    char out_dir[1024];
+    if (cfg->out_dir) snprintf(out_dir, sizeof out_dir, "%s", cfg->out_dir);
+    else snprintf(out_dir, sizeof out_dir, "out/%s-%s", scene.name, solver->name);
+    Simulation sim;
+    memset(&sim, 0, sizeof sim);
+    FILE *steps_csv = NULL, *frames_csv = NULL, *iters_csv = NULL;
+    StepWork work = {.dv = NULL, .cap = 0};
+    if ((status = paths_mkdir_p(out_dir))) goto done;
+    if (cfg->particles_dir && (status = paths_mkdir_p(cfg->particles_dir))) goto done;
+    if (!(steps_csv = open_in(out_dir, "steps.csv", &status))) goto done;
+    if (!(frames_csv = open_in(out_dir, "frames.csv", &status))) goto done;
+    if (cfg->history && !(iters_csv = open_in(out_dir, "iters.csv", &status))) goto done;
+    if ((status = run_accuracy_open(&acc, out_dir, &scene))) goto done;
+    write_run_json(out_dir, cfg, &scene, solver, &set, &acc, frames, threads, &status);
+    if (status) goto done;
+    fprintf(steps_csv, "scene,solver,frame,step,t,dt,particles,active_nodes,hessian_blocks,outer_iters,linear_iters,"
+                       "ls_evals,residual,status,wall_s,p2g_s,assemble_s,setup_s,solve_s,linesearch_s,g2p_s,threads,"
+                       "inner_iters,max_energy_rise,%s,reason\n",
+            run_accuracy_step_header);
+    fprintf(frames_csv,
+            "scene,solver,frame,steps,outer_iters,linear_iters,wall_s,max_residual,status,threads,inner_iters,%s,reason\n",
+            run_accuracy_frame_header);
+    if (iters_csv) fprintf(iters_csv, "frame,step,iter,elapsed_s,residual,energy\n");
+
+    if ((status = sim_init(&sim, &scene))) goto done;
+    sum->particles = scene.particles.n;
+    sum->threads = threads;
+    Progress prog;
+    progress_init(&prog, frames);
+    if (!cfg->quiet) {
+        printf("scene %s (%zu particles, dx %.4g m), solver %s, eps %.1e, %d threads\n", scene.name, scene.particles.n,
+               scene.dx, solver->name, cfg->eps, threads);
+        if (acc.ref) printf("error reference: %s (its time is in ref_s, not in the timings)\n", error_ref_describe(acc.ref));
+        printf("%6s %6s %8s %9s %9s %10s %12s  %s\n", "frame", "steps", "outer", "linear", "inner", "wall_s",
+               "max_resid", "status");
+    }
+    HookCtx hook = {iters_csv, &prog, 0, 0, 0.0};
+    double run_t0 = omp_get_wtime();
+    char deadline_why[64];
+    char stop_reason[300] = "";
+    while (sim.frame < frames && !sum->stopped) {
+        int frame = sim.frame, fsteps = 0, fstatus = SOLVE_CONVERGED;
+        long fouter = 0, flinear = 0, finner = 0;
+        double fwall = 0.0, fmaxres = 0.0;
+        char freason[256] = "";
+        while (sim.frame == frame) {
+            hook.frame = frame;
+            hook.step = fsteps;
+            hook.fraction = (frame + sim.t_in_frame / sim.frame_dt) / frames;
+            set_deadline(cfg, run_t0, &set, deadline_why, sizeof deadline_why);
+            if ((status = run_accuracy_before_step(&acc, &sim, fsteps, &work))) goto done;
+            SolveStats ss;
+            StepInfo si;
+            if ((status = run_step(&sim, solver, &set, &work, iter_hook, &hook, cfg->on_failure == RUN_CONTINUE, &ss,
+                                   &si)))
+                goto done;
+            run_t0 += si.after_solve_s; /* the reference solve is not the run's time either */
+            /* t and dt read back as the same doubles (--dt-from replays them) */
+            fprintf(steps_csv, "%s,%s,%d,%d,%.17g,%.17g,%zu,%d,%lld,%d,%ld,%d,%.6e,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%ld,",
+                    scene.name, solver->name, frame, fsteps, si.t, si.dt, sim.p.n, si.active_nodes,
+                    (long long)ss.hessian_blocks, ss.outer_iters, ss.linear_iters, ss.ls_evals, ss.residual,
+                    solve_status_name(ss.status), si.wall_s, si.begin_s, ss.assemble_s, ss.setup_s, ss.solve_s,
+                    ss.linesearch_s, si.end_s, threads, ss.inner_iters);
+            fprintf(steps_csv, "%.9g,", ss.energy_increase_max);
+            run_accuracy_step_fields(steps_csv, &acc);
+            csv_text(steps_csv, ss.reason); /* the reason stays the last field */
+            fputc('\n', steps_csv);
+            fsteps++;
+            fouter += ss.outer_iters;
+            flinear += ss.linear_iters;
+            finner += ss.inner_iters;
+            fwall += si.wall_s;
+            if (!(ss.residual <= fmaxres)) fmaxres = ss.residual; /* NaN included */
+            if ((int)ss.status > fstatus) snprintf(freason, sizeof freason, "%s", ss.reason);
+            fstatus = worse(fstatus, ss.status);
+            if (!si.advanced) { /* a failure the policy does not (or cannot) go past */
+                snprintf(stop_reason, sizeof stop_reason, "frame %d step %d failed: %s", frame, fsteps - 1, ss.reason);
+                sum->stopped = 1;
+                break;
+            }
+            if (cfg->max_run_s > 0 && omp_get_wtime() - run_t0 >= cfg->max_run_s) {
+                /* the run's budget is spent: this step was the last */
+                snprintf(stop_reason, sizeof stop_reason, "time limit --max-run-seconds %g reached at frame %d step %d",
+                         cfg->max_run_s, frame, fsteps - 1);
+                if (sim.frame == frame && fstatus < SOLVE_TIMEOUT) { /* the frame is cut short */
+                    snprintf(freason, sizeof freason, "%s", stop_reason);
+                    fstatus = SOLVE_TIMEOUT;
+                }
+                sum->stopped = 1;
+                break;
+            }
+        }
+        fprintf(frames_csv, "%s,%s,%d,%d,%ld,%ld,%.6f,%.6e,%s,%d,%ld,", scene.name, solver->name, frame, fsteps, fouter,
+                flinear, fwall, fmaxres, solve_status_name((SolveStatus)fstatus), threads, finner);
+        int acc_status = run_accuracy_frame_end(&acc, &sim, frame, fsteps, sim.frame > frame, frames_csv);
+        csv_text(frames_csv, freason);
+        fputc('\n', frames_csv);
+        if ((status = acc_status)) goto done;
+        fflush(steps_csv);
+        fflush(frames_csv);
+        progress_clear(&prog);
+        if (!cfg->quiet)
+            printf("%6d %6d %8ld %9ld %9ld %10.3f %12.3e  %s\n", frame, fsteps, fouter, flinear, finner, fwall, fmaxres,
+                   solve_status_name((SolveStatus)fstatus));
+        fflush(stdout);
+        if (cfg->particles_dir && !sum->stopped) {
+            char path[1200];
+            snprintf(path, sizeof path, "%s/frame_%04d.ply", cfg->particles_dir, frame + 1);
+            if ((status = ply_write_particles(path, &sim.p))) goto done;
+        }
+        sum->frames++;
+        sum->steps += fsteps;
+        sum->outer_iters += fouter;
+        sum->linear_iters += flinear;
+        sum->inner_iters += finner;
+        if (fmaxres > sum->max_residual) sum->max_residual = fmaxres;
+        sum->worst_status = worse(sum->worst_status, fstatus);
+    }
+    fflush(steps_csv);
+    fflush(frames_csv);
+    progress_clear(&prog);
+    sum->wall_s = omp_get_wtime() - run_t0;
+    if (sum->stopped) fprintf(stderr, "mpmbench: run stopped: %s\n", stop_reason);
+    if (!cfg->quiet) {
+        printf("total: %d frames, %d steps, %ld outer, %ld linear, %ld inner iterations, %.3f s wall (%.3f s/frame), "
+               "worst status %s\n",
+               sum->frames, sum->steps, sum->outer_iters, sum->linear_iters, sum->inner_iters, sum->wall_s,
+               sum->frames ? sum->wall_s / sum->frames : 0.0, solve_status_name((SolveStatus)sum->worst_status));
+        printf("wrote %s/steps.csv and %s/frames.csv%s\n", out_dir, out_dir, iters_csv ? " and iters.csv" : "");
+    }
+    /* the parts' statistics through the view op: the hierarchy of the last
+     * setup (HOT Fig. 8: blocks per row per level; none when every step
+     * converged at its initial guess) and the named statistics */
+    InvView view;
+    solver_view(solver, cfg->quiet ? NULL : stdout, &view);
+    if (view.n_levels > 0) {
+        FILE *lv = open_in(out_dir, "mg_levels.csv", &status);
+        if (!lv) goto done;
+        fprintf(lv, "level,nodes,blocks,blocks_per_row_avg,blocks_per_row_max\n");
+        for (int l = 0; l < view.n_levels; ++l)
+            fprintf(lv, "%d,%d,%lld,%.2f,%d\n", l, view.level[l].nodes, (long long)view.level[l].blocks,
+                    view.level[l].blocks_per_row_avg, view.level[l].blocks_per_row_max);
+        fclose(lv);
+    }
+    FILE *is = open_in(out_dir, "inverse_stats.csv", &status);
+    if (!is) goto done;
+    fprintf(is, "inverse,key,value\n");
+    for (int k = 0; k < view.n_stats; ++k)
+        fprintf(is, "%s,%s,%.9g\n", solver->inv->ops->name, view.stat[k].key, view.stat[k].value);
+    fclose(is);
+done:
+    if (steps_csv) fclose(steps_csv);
+    if (frames_csv) fclose(frames_csv);
+    if (iters_csv) fclose(iters_csv);
+    free(work.dv);
+    run_accuracy_free(&acc);
+    sim_free(&sim);
+    solver_destroy(solver);
+    scene_free(&scene);
+    return status;
+}
