@@ -1,6 +1,7 @@
-#!/usr/bin/python3
+#!/usr/bin/env python3
 """Report of an experiment-matrix run: `mpmbench matrix report DIR` runs this
-with /usr/bin/python3 (Debian's python3-matplotlib is for that interpreter).
+with the python3 on PATH (or MPM_PYTHON), which needs matplotlib (Debian:
+python3-matplotlib; or pip install matplotlib in a virtual environment).
 
 usage: matrix_report.py DIR
 
@@ -491,7 +492,8 @@ def main(argv):
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
-        die(f"{sys.executable} has no matplotlib (Debian: apt-get install python3-matplotlib)", 1)
+        die(f"{sys.executable} has no matplotlib (Debian: apt-get install python3-matplotlib; "
+            "in a virtual environment: pip install matplotlib)", 1)
     baseline = meta.get("baseline") or ""
     references = [c for c in cells if c.row.get("role") == "reference"]
     cells = [c for c in cells if c.row.get("role") != "reference"]

@@ -107,9 +107,7 @@ int bench_run(const char *what, const RunConfig *cfg)
     if (cfg->threads > 0) omp_set_num_threads(cfg->threads);
     int threads = omp_get_max_threads();
     Scene scene;
-    SceneLoadOptions lo = {.scale = cfg->scale, .overrides = cfg->overrides, .n_overrides = cfg->n_overrides,
-                           .asset_dir = cfg->asset_dir, .max_particles = cfg->max_particles};
-    if ((status = scene_load(cfg->scene, &lo, &scene))) return status;
+    if ((status = run_scene_load(cfg, &scene))) return status;
     Simulation sim;
     Bsr H = {0};
     BenchCtx bc = {0};

@@ -108,70 +108,99 @@ static void text_kv(Text *t, const MatrixKv *kv, int n)
     text_add(t, "}");
 }
 
+/* One "key": value of the canonical form. */
+typedef struct {
+    const char *key;
+    Text value;
+} Entry;
+
+static int cmp_entry(const void *a, const void *b) { return strcmp(((const Entry *)a)->key, ((const Entry *)b)->key); }
+
+/* The value of run setting o in the cell, as canonical JSON text. */
+static void setting_text(const Option *o, const MatrixCell *c, Text *t)
+{
+    if (o->type == OPT_LIST) {
+        if (o->flags & OPT_KEY_JSON) text_kv(t, c->set, c->n_set);
+        else text_kv(t, c->solver_opts, c->n_solver_opts);
+        return;
+    }
+    OptionValue v;
+    option_get(o, &c->run, &v);
+    if (o->flags & OPT_KEY_SUBDIR) {
+        text_add(t, v.s ? "true" : "false");
+        return;
+    }
+    switch (o->type) {
+    case OPT_SWITCH:
+        text_add(t, v.i ? "true" : "false");
+        break;
+    case OPT_INT:
+        text_int(t, v.i);
+        break;
+    case OPT_REAL:
+        text_number(t, v.d);
+        break;
+    case OPT_SIZE:
+        text_number(t, (double)v.z);
+        break;
+    case OPT_CHOICE:
+        text_string(t, o->choices[v.i]);
+        break;
+    case OPT_TEXT:
+        text_string(t, v.s ? v.s : "");
+        break;
+    case OPT_LIST:
+        break;
+    }
+}
+
+/* Does run setting k enter the cell's id? OPT_ID_ALWAYS ones do; OPT_ID_GIVEN
+ * ones (added after the first results were made) only when given, a switch
+ * only when on, so that the cells without them keep their ids. */
+static int in_id(int k, const MatrixCell *c)
+{
+    const Option *o = &run_settings[k];
+    if (!o->key) return 0;
+    if (o->flags & OPT_ID_ALWAYS) return 1;
+    if (!(o->flags & OPT_ID_GIVEN)) return 0;
+    if (o->type == OPT_SWITCH) {
+        OptionValue v;
+        option_get(o, &c->run, &v);
+        return v.i != 0;
+    }
+    return (int)(c->given >> k & 1);
+}
+
 /* The canonical serialisation (JSON, keys in alphabetical order, numbers as
  * the shortest text that reads back the same, so no library's number
- * formatting enters an id) and the id derived from it. */
+ * formatting enters an id) and the id derived from it: the run settings of
+ * the table (in_id) and the matrix's first_timed_frame and reference. */
 static int cell_identify(MatrixCell *c)
 {
-    Text t = {NULL, 0, 0, 0};
-    /* the settings added with the accuracy axis and the limits enter only when
-     * set, so the ids of cells without them stay as they were */
-    text_add(&t, "{");
-    text_key(&t, "armijo", 1);
-    text_add(&t, c->armijo ? "true" : "false");
-    text_key(&t, "eps", 0);
-    text_number(&t, c->eps);
-    if (c->error_ref[0]) {
-        text_key(&t, "error_ref", 0);
-        text_string(&t, c->error_ref);
+    Entry e[RUN_SETTINGS_MAX + 2];
+    int n = 0;
+    for (int k = 0; k < run_settings_count; ++k) {
+        if (!in_id(k, c)) continue;
+        e[n].key = run_settings[k].key;
+        e[n].value = (Text){NULL, 0, 0, 0};
+        setting_text(&run_settings[k], c, &e[n++].value);
     }
-    text_key(&t, "first_timed_frame", 0);
-    text_int(&t, c->first_timed_frame);
-    text_key(&t, "frames", 0);
-    text_int(&t, c->frames);
-    text_key(&t, "history", 0);
-    text_add(&t, c->history ? "true" : "false");
-    if (c->max_linear) {
-        text_key(&t, "max_linear", 0);
-        text_int(&t, c->max_linear);
-    }
-    if (c->max_outer) {
-        text_key(&t, "max_outer", 0);
-        text_int(&t, c->max_outer);
-    }
-    if (c->max_run_s > 0) {
-        text_key(&t, "max_run_seconds", 0);
-        text_number(&t, c->max_run_s);
-    }
-    if (c->max_step_s > 0) {
-        text_key(&t, "max_step_seconds", 0);
-        text_number(&t, c->max_step_s);
-    }
-    if (c->on_failure[0]) {
-        text_key(&t, "on_failure", 0);
-        text_string(&t, c->on_failure);
-    }
-    text_key(&t, "particles", 0);
-    text_add(&t, c->particles ? "true" : "false");
+    e[n].key = "first_timed_frame";
+    e[n].value = (Text){NULL, 0, 0, 0};
+    text_int(&e[n++].value, c->first_timed_frame);
     if (c->ref_id[0]) {
-        text_key(&t, "reference", 0);
-        text_string(&t, c->ref_id);
+        e[n].key = "reference";
+        e[n].value = (Text){NULL, 0, 0, 0};
+        text_string(&e[n++].value, c->ref_id);
     }
-    text_key(&t, "scale", 0);
-    text_number(&t, c->scale);
-    text_key(&t, "scene", 0);
-    text_string(&t, c->scene);
-    text_key(&t, "set", 0);
-    text_kv(&t, c->set, c->n_set);
-    text_key(&t, "solver", 0);
-    text_string(&t, c->solver);
-    text_key(&t, "solver_opts", 0);
-    text_kv(&t, c->solver_opts, c->n_solver_opts);
-    text_key(&t, "threads", 0);
-    text_int(&t, c->threads);
-    if (c->trajectory) {
-        text_key(&t, "trajectory", 0);
-        text_add(&t, "true");
+    qsort(e, (size_t)n, sizeof e[0], cmp_entry);
+    Text t = {NULL, 0, 0, 0};
+    text_add(&t, "{");
+    for (int i = 0; i < n; ++i) {
+        text_key(&t, e[i].key, i == 0);
+        if (e[i].value.bad || !e[i].value.s) t.bad = 1;
+        else text_add(&t, e[i].value.s);
+        free(e[i].value.s);
     }
     text_add(&t, "}");
     if (t.bad) {
@@ -183,18 +212,25 @@ static int cell_identify(MatrixCell *c)
     return MPM_OK;
 }
 
-/* The cell's value of a rule key as text (string axes, labels) or number. */
+/* Does the cell have the rule's value v for key (a run setting's axis, by
+ * number or text, or a named axis, by label)? */
 static int rule_value_matches(const Matrix *m, const MatrixCell *c, const char *key, json_t *v)
 {
-    if (!strcmp(key, "eps")) return json_number_value(v) == c->eps;
-    if (!strcmp(key, "scale")) return json_number_value(v) == c->scale;
-    if (!strcmp(key, "threads")) return json_integer_value(v) == c->threads;
+    int k = run_setting_index(key);
+    if (k >= 0 && run_settings[k].type != OPT_TEXT) {
+        OptionValue x;
+        option_get(&run_settings[k], &c->run, &x);
+        if (run_settings[k].type == OPT_REAL) return json_number_value(v) == x.d;
+        return json_integer_value(v) == x.i;
+    }
     char text[256];
     if (json_is_number(v)) matrix_format_number(json_number_value(v), text, sizeof text);
     else snprintf(text, sizeof text, "%s", json_string_value(v));
-    if (!strcmp(key, "scene")) return !strcmp(text, c->scene);
-    if (!strcmp(key, "solver")) return !strcmp(text, c->solver);
-    if (!strcmp(key, "error_ref")) return !strcmp(text, c->error_ref);
+    if (k >= 0) {
+        OptionValue x;
+        option_get(&run_settings[k], &c->run, &x);
+        return !strcmp(text, x.s ? x.s : "");
+    }
     int a = matrix_named_index(m, key);
     return a >= 0 && !strcmp(text, m->named[a].values[c->value[a]].label);
 }
@@ -246,68 +282,71 @@ static int copy_kv(const MatrixKvList *l, MatrixKv **out, int *n)
     return MPM_OK;
 }
 
-/* The run limits and error reference: defaults < per-scene settings. */
-static void run_settings(const MatrixSettings *d, const MatrixSettings *ps, MatrixCell *c)
+static void apply(MatrixCell *c, int k, const OptionValue *v, const char *origin)
 {
-    const MatrixSettings *src[2] = {d, ps};
-    for (int k = 0; k < 2; ++k) {
-        const MatrixSettings *s = src[k];
-        if (!s) continue;
-        if (s->has_error_ref) snprintf(c->error_ref, sizeof c->error_ref, "%s", s->error_ref);
-        if (s->has_trajectory) c->trajectory = s->trajectory;
-        if (s->has_max_outer) c->max_outer = s->max_outer;
-        if (s->has_max_linear) c->max_linear = s->max_linear;
-        if (s->has_max_step_s) c->max_step_s = s->max_step_s;
-        if (s->has_max_run_s) c->max_run_s = s->max_run_s;
-        if (s->has_on_failure) snprintf(c->on_failure, sizeof c->on_failure, "%s", s->on_failure);
-    }
+    option_set(&run_settings[k], &c->run, v);
+    c->given |= 1ull << k;
+    c->origin[k] = origin;
 }
 
-#define FIXED_AXES 6 /* scene, solver, eps, scale, threads, error_ref */
+/* The run settings axes (table order: the scene varies slowest) and their
+ * number. */
+static int fixed_axes(int *setting)
+{
+    int n = 0;
+    for (int k = 0; k < run_settings_count; ++k)
+        if (run_settings[k].flags & OPT_AXIS) setting[n++] = k;
+    return n;
+}
 
-/* The cell at one point of the product: idx[0..5] index scene, solver, eps,
- * scale, threads, error_ref (-1 = the defaults' value), idx[FIXED_AXES+a]
- * the named axis a. Not identified yet (cell_identify). */
+/* The cell at one point of the product: idx[a] indexes the values of the
+ * fixed axis a (fixed_axes; -1 = not an axis), idx[n_fixed + a] the named
+ * axis a. Each run setting: the defaults' value < the scene's < the axis's.
+ * Not identified yet (cell_identify). */
 static int build_cell(const Matrix *m, const int *idx, MatrixCell *c)
 {
     const MatrixSettings *d = &m->defaults;
     memset(c, 0, sizeof *c);
-    snprintf(c->scene, sizeof c->scene, "%s", idx[0] >= 0 ? m->scenes[idx[0]] : d->scene);
-    if (idx[0] >= 0) snprintf(c->scene_origin, sizeof c->scene_origin, "axes.scene[%d]", idx[0]);
-    else snprintf(c->scene_origin, sizeof c->scene_origin, "%s", d->scene_origin);
-    snprintf(c->solver, sizeof c->solver, "%s", idx[1] >= 0 ? m->solvers[idx[1]] : d->solver);
-    if (idx[1] >= 0) snprintf(c->solver_origin, sizeof c->solver_origin, "axes.solver[%d]", idx[1]);
-    else snprintf(c->solver_origin, sizeof c->solver_origin, "%s", d->solver_origin);
-    const MatrixSettings *ps = scene_settings(m, c->scene);
-    c->eps = d->has_eps ? d->eps : 1e-7;
-    c->scale = ps && ps->has_scale ? ps->scale : d->has_scale ? d->scale : 1.0;
-    c->threads = d->has_threads ? d->threads : 0;
-    c->frames = ps && ps->has_frames ? ps->frames : d->has_frames ? d->frames : 0;
+    run_config_default(&c->run);
+    int fixed[RUN_SETTINGS_MAX], n_fixed = fixed_axes(fixed);
+    /* the scene first: its per-scene settings apply */
+    const char *scene = d->run.scene;
+    for (int a = 0; a < n_fixed; ++a)
+        if (fixed[a] == run_setting_index("scene") && idx[a] >= 0) scene = m->axis[fixed[a]].values[idx[a]].s;
+    const MatrixSettings *ps = scene_settings(m, scene);
+    for (int k = 0; k < run_settings_count; ++k) {
+        if (!run_settings[k].key || run_settings[k].type == OPT_LIST) continue;
+        OptionValue v;
+        if (d->given >> k & 1) {
+            option_get(&run_settings[k], &d->run, &v);
+            apply(c, k, &v, d->origin[k]);
+        }
+        if (ps && (ps->given >> k & 1)) {
+            option_get(&run_settings[k], &ps->run, &v);
+            apply(c, k, &v, ps->origin[k]);
+        }
+    }
+    for (int a = 0; a < n_fixed; ++a)
+        if (idx[a] >= 0) apply(c, fixed[a], &m->axis[fixed[a]].values[idx[a]], m->axis[fixed[a]].origins[idx[a]]);
     c->first_timed_frame = ps && ps->has_first ? ps->first_timed_frame : d->has_first ? d->first_timed_frame : 0;
-    if (idx[2] >= 0) c->eps = m->eps[idx[2]];
-    if (idx[3] >= 0) c->scale = m->scales[idx[3]];
-    if (idx[4] >= 0) c->threads = m->threads[idx[4]];
-    c->history = d->history;
-    c->armijo = d->armijo;
-    c->particles = d->particles;
-    snprintf(c->asset_dir, sizeof c->asset_dir, "%s", d->has_asset_dir ? d->asset_dir : "");
     c->timeout_s = m->cell_timeout_s;
     c->ref = -1;
-    run_settings(d, ps, c);
-    if (idx[5] >= 0) snprintf(c->error_ref, sizeof c->error_ref, "%s", m->error_refs[idx[5]]);
     MatrixKvList set = d->set, opts = d->solver_opts;
-    int st = ps ? kv_merge(m, c->scene, &set, &ps->set) : MPM_OK;
+    int st = ps ? kv_merge(m, scene, &set, &ps->set) : MPM_OK;
     for (int a = 0; a < m->n_named && !st; ++a) {
-        c->value[a] = idx[FIXED_AXES + a];
-        const MatrixNamedValue *v = &m->named[a].values[idx[FIXED_AXES + a]];
-        st = kv_merge(m, c->scene, m->named[a].kind == MATRIX_SET ? &set : &opts, &v->kv);
+        c->value[a] = idx[n_fixed + a];
+        const MatrixNamedValue *v = &m->named[a].values[idx[n_fixed + a]];
+        st = kv_merge(m, scene, m->named[a].kind == MATRIX_SET ? &set : &opts, &v->kv);
     }
     if (st) return st;
-    if (c->frames > 0 && c->first_timed_frame >= c->frames)
-        return mpm_error(MPM_EINPUT, "%s: scene \"%s\": first_timed_frame %d is not before frames %d", m->base, c->scene,
-                         c->first_timed_frame, c->frames);
+    if (c->run.frames > 0 && c->first_timed_frame >= c->run.frames)
+        return mpm_error(MPM_EINPUT, "%s: scene \"%s\": first_timed_frame %d is not before frames %d", m->base, scene,
+                         c->first_timed_frame, c->run.frames);
     st = copy_kv(&set, &c->set, &c->n_set);
     if (!st) st = copy_kv(&opts, &c->solver_opts, &c->n_solver_opts);
+    for (int k = 0; k < run_settings_count; ++k) /* a list is given when it has entries */
+        if (run_settings[k].type == OPT_LIST && (run_settings[k].flags & OPT_KEY_JSON ? c->n_set : c->n_solver_opts))
+            c->given |= 1ull << k;
     return st;
 }
 
@@ -327,12 +366,17 @@ static int build_reference(const MatrixReference *r, const MatrixCell *c, Matrix
     ref->set = ref->solver_opts = NULL;
     ref->canonical = NULL;
     ref->n_set = ref->n_solver_opts = 0;
-    snprintf(ref->solver, sizeof ref->solver, "%s", r->solver);
-    snprintf(ref->solver_origin, sizeof ref->solver_origin, "%s.solver", r->origin);
-    ref->eps = r->eps;
-    ref->error_ref[0] = '\0';
-    ref->trajectory = 1;
-    ref->history = ref->particles = 0;
+    OptionValue v;
+    v.s = r->solver;
+    apply(ref, run_setting_index("solver"), &v, r->solver_origin);
+    v.d = r->eps;
+    apply(ref, run_setting_index("eps"), &v, r->origin);
+    v.i = 1;
+    apply(ref, run_setting_index("trajectory"), &v, r->origin);
+    ref->run.error_ref = NULL;
+    ref->given &= ~(1ull << run_setting_index("error_ref"));
+    ref->run.history = 0;
+    ref->run.particles_dir = NULL;
     ref->is_reference = 1;
     ref->ref = -1;
     ref->ref_id[0] = '\0';
@@ -388,15 +432,11 @@ static int prepend_references(MatrixCells *out, MatrixCell *refs, int n_refs)
 int matrix_expand(const Matrix *m, MatrixCells *out)
 {
     memset(out, 0, sizeof *out);
-    int n_axes = FIXED_AXES + m->n_named;
-    int size[FIXED_AXES + MATRIX_MAX_AXES];
-    size[0] = m->n_scenes;
-    size[1] = m->n_solvers;
-    size[2] = m->n_eps;
-    size[3] = m->n_scales;
-    size[4] = m->n_threads;
-    size[5] = m->n_error_refs;
-    for (int a = 0; a < m->n_named; ++a) size[FIXED_AXES + a] = m->named[a].n;
+    int fixed[RUN_SETTINGS_MAX], n_fixed = fixed_axes(fixed);
+    int n_axes = n_fixed + m->n_named;
+    int size[RUN_SETTINGS_MAX + MATRIX_MAX_AXES];
+    for (int a = 0; a < n_fixed; ++a) size[a] = m->axis[fixed[a]].n;
+    for (int a = 0; a < m->n_named; ++a) size[n_fixed + a] = m->named[a].n;
     size_t total = 1;
     for (int a = 0; a < n_axes; ++a) {
         total *= (size_t)(size[a] > 0 ? size[a] : 1);
@@ -409,14 +449,14 @@ int matrix_expand(const Matrix *m, MatrixCells *out)
         free(refs);
         return mpm_error(MPM_EINTERNAL, "out of memory (%zu cells)", total);
     }
-    int idx[FIXED_AXES + MATRIX_MAX_AXES];
+    int idx[RUN_SETTINGS_MAX + MATRIX_MAX_AXES];
     for (int a = 0; a < n_axes; ++a) idx[a] = size[a] > 0 ? 0 : -1;
     int st = MPM_OK;
     for (size_t k = 0; k < total && !st; ++k) {
         MatrixCell *c = &out->cells[out->n];
         st = build_cell(m, idx, c);
         int keep = !st && rules_keep(m, c);
-        const MatrixReference *r = keep ? scene_reference(m, c->scene) : NULL;
+        const MatrixReference *r = keep ? scene_reference(m, c->run.scene) : NULL;
         if (r) { /* the reference first: its id is part of the cell's settings */
             MatrixCell *rc = &refs[n_refs];
             st = build_reference(r, c, rc);
@@ -468,118 +508,66 @@ void matrix_cells_keep(MatrixCells *c, const int *keep)
     free(moved);
 }
 
-void matrix_cell_name(const MatrixCell *c, char *out, size_t n) { snprintf(out, n, "%s/%s", c->scene, c->solver); }
+void matrix_cell_name(const MatrixCell *c, char *out, size_t n) { snprintf(out, n, "%s/%s", c->run.scene, c->run.solver); }
 
 void matrix_cell_describe(const Matrix *m, const MatrixCell *c, char *out, size_t n)
 {
     char eps[32], scale[32];
-    matrix_format_number(c->eps, eps, sizeof eps);
-    matrix_format_number(c->scale, scale, sizeof scale);
+    matrix_format_number(c->run.eps, eps, sizeof eps);
+    matrix_format_number(c->run.scale, scale, sizeof scale);
     size_t len = (size_t)snprintf(out, n, "eps=%s scale=%s", eps, scale);
-    if (c->threads && len < n) len += (size_t)snprintf(out + len, n - len, " threads=%d", c->threads);
-    if (c->frames && len < n) len += (size_t)snprintf(out + len, n - len, " frames=%d", c->frames);
+    if (c->run.threads && len < n) len += (size_t)snprintf(out + len, n - len, " threads=%d", c->run.threads);
+    if (c->run.frames && len < n) len += (size_t)snprintf(out + len, n - len, " frames=%d", c->run.frames);
     if (c->first_timed_frame && len < n) len += (size_t)snprintf(out + len, n - len, " timed-from=%d", c->first_timed_frame);
-    if (c->error_ref[0] && len < n) len += (size_t)snprintf(out + len, n - len, " error_ref=%s", c->error_ref);
+    if (c->run.error_ref && len < n) len += (size_t)snprintf(out + len, n - len, " error_ref=%s", c->run.error_ref);
     for (int a = 0; a < m->n_named && len < n; ++a)
         len += (size_t)snprintf(out + len, n - len, " %s=%s", m->named[a].name, m->named[a].values[c->value[a]].label);
     if (c->is_reference && len < n) len += (size_t)snprintf(out + len, n - len, " (reference run)");
     else if (c->ref_id[0] && len < n) len += (size_t)snprintf(out + len, n - len, " reference=%s", c->ref_id);
 }
 
-/* Appends one NUL-terminated argument. */
-static int push_arg(char *buf, size_t cap, size_t *used, int *argc, const char *fmt, const char *a, const char *b)
+int matrix_cell_config(const Matrix *m, const MatrixCell *c, const char *out_dir, RunConfig *cfg,
+                       MatrixCellTexts *texts)
 {
-    int w = snprintf(buf + *used, cap - *used, fmt, a, b);
-    if (w < 0 || (size_t)w + 1 > cap - *used) return mpm_error(MPM_EINPUT, "cell command line too long");
-    *used += (size_t)w + 1;
-    (*argc)++;
+    *cfg = c->run;
+    matrix_scene_path(m, c->run.scene, texts->scene, sizeof texts->scene);
+    cfg->scene = texts->scene;
+    int w = 0;
+    if (c->run.particles_dir) {
+        w = snprintf(texts->particles, sizeof texts->particles, "%s/%s", out_dir, c->run.particles_dir);
+        if (w < 0 || (size_t)w >= sizeof texts->particles) return mpm_error(MPM_EINPUT, "cell command line too long");
+        cfg->particles_dir = texts->particles;
+    }
+    cfg->n_set = cfg->n_solver_opts = 0;
+    for (int i = 0; i < c->n_set && i < RUN_MAX_LIST; ++i) {
+        snprintf(texts->set[i], sizeof texts->set[i], "%s=%s", c->set[i].key, c->set[i].value);
+        cfg->set[cfg->n_set++] = texts->set[i];
+    }
+    for (int i = 0; i < c->n_solver_opts && i < RUN_MAX_LIST; ++i) {
+        snprintf(texts->solver_opts[i], sizeof texts->solver_opts[i], "%s=%s", c->solver_opts[i].key,
+                 c->solver_opts[i].value);
+        cfg->solver_opts[cfg->n_solver_opts++] = texts->solver_opts[i];
+    }
+    if (c->ref_id[0]) { /* the reference's directory: out_dir's sibling */
+        const char *slash = strrchr(out_dir, '/');
+        w = slash ? snprintf(texts->reference, sizeof texts->reference, "%.*s/%s", (int)(slash - out_dir), out_dir,
+                             c->ref_id)
+                  : snprintf(texts->reference, sizeof texts->reference, "%s", c->ref_id);
+        if (w < 0 || (size_t)w >= sizeof texts->reference) return mpm_error(MPM_EINPUT, "cell command line too long");
+        cfg->dt_from = cfg->trajectory_ref = texts->reference;
+    }
+    cfg->quiet = 1;
+    cfg->out_dir = out_dir;
     return MPM_OK;
 }
 
 int matrix_cell_argv(const Matrix *m, const MatrixCell *c, const char *out_dir, char *buf, size_t cap, int *argc)
 {
-    size_t used = 0;
-    *argc = 0;
-    char path[2048], num[64], ply[1100];
-    matrix_scene_path(m, c->scene, path, sizeof path);
-    int st = push_arg(buf, cap, &used, argc, "%s%s", "run", "");
-    st |= push_arg(buf, cap, &used, argc, "%s%s", "--scene", "");
-    st |= push_arg(buf, cap, &used, argc, "%s%s", path, "");
-    st |= push_arg(buf, cap, &used, argc, "%s%s", "--solver", "");
-    st |= push_arg(buf, cap, &used, argc, "%s%s", c->solver, "");
-    matrix_format_number(c->eps, num, sizeof num); /* reads back as the same double */
-    st |= push_arg(buf, cap, &used, argc, "%s%s", "--eps", "");
-    st |= push_arg(buf, cap, &used, argc, "%s%s", num, "");
-    matrix_format_number(c->scale, num, sizeof num);
-    st |= push_arg(buf, cap, &used, argc, "%s%s", "--scale", "");
-    st |= push_arg(buf, cap, &used, argc, "%s%s", num, "");
-    if (c->threads) {
-        snprintf(num, sizeof num, "%d", c->threads);
-        st |= push_arg(buf, cap, &used, argc, "%s%s", "--threads", "");
-        st |= push_arg(buf, cap, &used, argc, "%s%s", num, "");
-    }
-    if (c->frames) {
-        snprintf(num, sizeof num, "%d", c->frames);
-        st |= push_arg(buf, cap, &used, argc, "%s%s", "--frames", "");
-        st |= push_arg(buf, cap, &used, argc, "%s%s", num, "");
-    }
-    for (int i = 0; i < c->n_set; ++i) {
-        st |= push_arg(buf, cap, &used, argc, "%s%s", "--set", "");
-        st |= push_arg(buf, cap, &used, argc, "%s=%s", c->set[i].key, c->set[i].value);
-    }
-    for (int i = 0; i < c->n_solver_opts; ++i) {
-        st |= push_arg(buf, cap, &used, argc, "%s%s", "--solver-opt", "");
-        st |= push_arg(buf, cap, &used, argc, "%s=%s", c->solver_opts[i].key, c->solver_opts[i].value);
-    }
-    if (c->history) st |= push_arg(buf, cap, &used, argc, "%s%s", "--history", "");
-    if (c->armijo) st |= push_arg(buf, cap, &used, argc, "%s%s", "--armijo", "");
-    if (c->particles) {
-        snprintf(ply, sizeof ply, "%s/particles", out_dir);
-        st |= push_arg(buf, cap, &used, argc, "%s%s", "--particles", "");
-        st |= push_arg(buf, cap, &used, argc, "%s%s", ply, "");
-    }
-    if (c->asset_dir[0]) {
-        st |= push_arg(buf, cap, &used, argc, "%s%s", "--asset-dir", "");
-        st |= push_arg(buf, cap, &used, argc, "%s%s", c->asset_dir, "");
-    }
-    if (c->error_ref[0]) {
-        st |= push_arg(buf, cap, &used, argc, "%s%s", "--error-ref", "");
-        st |= push_arg(buf, cap, &used, argc, "%s%s", c->error_ref, "");
-    }
-    if (c->trajectory) st |= push_arg(buf, cap, &used, argc, "%s%s", "--trajectory", "");
-    const int ints[2] = {c->max_outer, c->max_linear};
-    const char *int_flags[2] = {"--max-outer", "--max-linear"};
-    for (int k = 0; k < 2; ++k) {
-        if (!ints[k]) continue;
-        snprintf(num, sizeof num, "%d", ints[k]);
-        st |= push_arg(buf, cap, &used, argc, "%s%s", int_flags[k], "");
-        st |= push_arg(buf, cap, &used, argc, "%s%s", num, "");
-    }
-    const double secs[2] = {c->max_step_s, c->max_run_s};
-    const char *sec_flags[2] = {"--max-step-seconds", "--max-run-seconds"};
-    for (int k = 0; k < 2; ++k) {
-        if (!(secs[k] > 0)) continue;
-        if (secs[k] == floor(secs[k])) snprintf(num, sizeof num, "%.0f", secs[k]); /* 30, not 3e+01 */
-        else matrix_format_number(secs[k], num, sizeof num);
-        st |= push_arg(buf, cap, &used, argc, "%s%s", sec_flags[k], "");
-        st |= push_arg(buf, cap, &used, argc, "%s%s", num, "");
-    }
-    if (c->on_failure[0]) {
-        st |= push_arg(buf, cap, &used, argc, "%s%s", "--on-failure", "");
-        st |= push_arg(buf, cap, &used, argc, "%s%s", c->on_failure, "");
-    }
-    if (c->ref_id[0]) { /* the reference's directory: out_dir's sibling */
-        const char *slash = strrchr(out_dir, '/');
-        int w = slash ? snprintf(ply, sizeof ply, "%.*s/%s", (int)(slash - out_dir), out_dir, c->ref_id)
-                      : snprintf(ply, sizeof ply, "%s", c->ref_id);
-        if (w < 0 || (size_t)w >= sizeof ply) st |= mpm_error(MPM_EINPUT, "cell command line too long");
-        st |= push_arg(buf, cap, &used, argc, "%s%s", "--dt-from", "");
-        st |= push_arg(buf, cap, &used, argc, "%s%s", ply, "");
-        st |= push_arg(buf, cap, &used, argc, "%s%s", "--trajectory-ref", "");
-        st |= push_arg(buf, cap, &used, argc, "%s%s", ply, "");
-    }
-    st |= push_arg(buf, cap, &used, argc, "%s%s", "--quiet", "");
-    st |= push_arg(buf, cap, &used, argc, "%s%s", "--out", "");
-    st |= push_arg(buf, cap, &used, argc, "%s%s", out_dir, "");
-    return st ? MPM_EINPUT : MPM_OK;
+    MatrixCellTexts *texts = malloc(sizeof *texts); /* 30 kB: not on the stack */
+    if (!texts) return mpm_error(MPM_EINTERNAL, "out of memory");
+    RunConfig cfg;
+    int st = matrix_cell_config(m, c, out_dir, &cfg, texts);
+    if (!st) st = run_config_argv(&cfg, buf, cap, argc);
+    free(texts);
+    return st;
 }

@@ -17,25 +17,21 @@
 
 typedef struct {
     char id[16];
-    char scene[1024];            /* as in the matrix */
-    char solver[128];
-    double eps, scale;
-    int threads;                 /* 0: OpenMP's default */
-    int frames;                  /* 0: the scene's */
+    /* the run settings (experiments/cli/run_settings.h): defaults < per-scene
+     * settings < axis values. Texts as in the matrix (the scene not yet a
+     * path; particles_dir "particles" = the cell's particles/ folder), in the
+     * matrix's pool; the lists are set and solver_opts below (run.n_set and
+     * run.n_solver_opts stay 0). matrix_cell_config makes the RunConfig the
+     * cell runs with. */
+    RunConfig run;
+    unsigned long long given;    /* bit k: run_settings[k] given in the file */
+    const char *origin[RUN_SETTINGS_MAX]; /* where each given setting came from */
     int first_timed_frame;
-    int history, armijo, particles;
-    char asset_dir[1024];        /* "" = none */
     MatrixKv *set, *solver_opts; /* merged, sorted by key */
     int n_set, n_solver_opts;
     int value[MATRIX_MAX_AXES];  /* value index of each named axis */
-    char scene_origin[256], solver_origin[256];
     char *canonical;
     double timeout_s;            /* 0 = none */
-    char error_ref[160];         /* "" = none */
-    int trajectory;
-    int max_outer, max_linear;   /* 0 = run's default */
-    double max_step_s, max_run_s;/* 0 = none */
-    char on_failure[16];         /* "" = run's default (stop) */
     int is_reference;            /* a reference run other cells depend on */
     int ref;                     /* index of this cell's reference cell, -1 = none */
     char ref_id[16];             /* its id ("" = none) */
@@ -64,10 +60,24 @@ void matrix_cell_name(const MatrixCell *c, char *out, size_t n);
 /* "eps=1e-07 scale=4.3 threads=2 frames=1 stiffness=1e+05 ..." */
 void matrix_cell_describe(const Matrix *m, const MatrixCell *c, char *out, size_t n);
 
+/* Texts a cell's RunConfig points to (matrix_cell_config). */
+typedef struct {
+    char scene[2048], particles[1100], reference[1100];
+    char set[MATRIX_MAX_KV][400], solver_opts[MATRIX_MAX_KV][400];
+} MatrixCellTexts;
+
+/* The RunConfig that computes the cell into out_dir: c->run with the scene
+ * as a path (matrix_scene_path), the particles into out_dir/particles, the
+ * lists as key=value texts, --quiet, --out out_dir, and for a dependent cell
+ * --dt-from and --trajectory-ref with its reference's directory (out_dir's
+ * sibling named by the reference's id). Its texts live in *texts.
+ * MPM_EINPUT when a path does not fit. */
+int matrix_cell_config(const Matrix *m, const MatrixCell *c, const char *out_dir, RunConfig *cfg,
+                       MatrixCellTexts *texts);
+
 /* The `mpmbench run` arguments (without the program) that compute the cell
- * into out_dir, NUL-separated in buf; *argc set. MPM_EINPUT if too long. A
- * dependent cell gets --dt-from and --trajectory-ref with its reference's
- * directory, the sibling of out_dir named by the reference's id. */
+ * into out_dir: run_config_argv of matrix_cell_config, NUL-separated in buf;
+ * *argc set. MPM_EINPUT if too long. */
 int matrix_cell_argv(const Matrix *m, const MatrixCell *c, const char *out_dir, char *buf, size_t cap, int *argc);
 
 #endif

@@ -129,9 +129,9 @@ static void check_steps(const MatrixCell *c, const char *dir, CellCheck *out, co
         if (!known_status(s) && !bad_status++) fail(out, "frame %s step %s: unknown status \"%s\"", fr, sp, s);
         double res = strtod(csv_get(&t, r, cr), NULL);
         /* the residual is printed with 7 digits: converged means below eps up to that rounding */
-        if (!strcmp(s, "converged") && !strcmp(stop, "cn") && !(res < c->eps * (1.0 + 1e-6)) && !bad_conv++)
+        if (!strcmp(s, "converged") && !strcmp(stop, "cn") && !(res < c->run.eps * (1.0 + 1e-6)) && !bad_conv++)
             fail(out, "frame %s step %s: status converged but residual %s is not below eps %g", fr, sp,
-                 csv_get(&t, r, cr), c->eps);
+                 csv_get(&t, r, cr), c->run.eps);
         double up = ce >= 0 ? strtod(csv_get(&t, r, ce), NULL) : 0.0;
         if (up > 0.0 && !rise++)
             fail(out, "frame %s step %s: a line search accepted an energy increase of %s", fr, sp, csv_get(&t, r, ce));
@@ -148,7 +148,7 @@ static void check_steps(const MatrixCell *c, const char *dir, CellCheck *out, co
     scan_non_finite(&t, "frames.csv", out);
     int done = t.n_rows;
     csv_free(&t);
-    int asked = c->frames > 0 ? c->frames : frames;
+    int asked = c->run.frames > 0 ? c->run.frames : frames;
     if (asked > 0 && done < asked && strcmp(last, "failed") && strcmp(last, "timeout"))
         fail(out, "ran %d of %d frames and its last step (%s) says nothing of why", done, asked, last[0] ? last : "none");
 }
@@ -218,10 +218,10 @@ int matrix_check_all(const Matrix *m, const MatrixCells *cells, const char *dir,
             matrix_check_cell(c, cdir, &t, row, &ck);
         }
         char eps[32], line[4096];
-        matrix_format_number(c->eps, eps, sizeof eps);
+        matrix_format_number(c->run.eps, eps, sizeof eps);
         size_t len = 0;
         line[0] = '\0';
-        const char *fields[3] = {c->scene, c->solver, eps};
+        const char *fields[3] = {c->run.scene, c->run.solver, eps};
         csv_put(line, sizeof line, &len, c->id);
         for (int k = 0; k < 3; ++k) {
             line[len++] = ',';

@@ -14,7 +14,7 @@
  *     timeout: the failure policy or --max-run-seconds stopped it).
  * DIR/check.csv gets one row per cell: id, scene, solver, eps, the named
  * axes' labels, pass (1/0), reasons; --check prints the failing cells and
- * makes `matrix run` exit 1 when any failed. */
+ * makes `matrix run` exit 3 when any failed. */
 #ifndef MPM_MATRIX_CHECK_H
 #define MPM_MATRIX_CHECK_H
 

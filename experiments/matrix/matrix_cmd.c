@@ -1,5 +1,7 @@
+/* `mpmbench matrix run|report` (matrix_cmd.h). */
 #include "experiments/matrix/matrix_cmd.h"
 
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -7,85 +9,108 @@
 #include <unistd.h>
 
 #include "core/error.h"
+#include "core/threads.h"
 #include "experiments/matrix/matrix_run.h"
 
 #ifndef MPM_SOURCE_DIR
 #define MPM_SOURCE_DIR "."
 #endif
 
-#define MAX_ONLY 64
+#define O(field) offsetof(MatrixRunOptions, field)
 
-static int parse_count(const char *flag, const char *s, int *out)
+static const Option matrix_run_options[] = {
+    {"--out", NULL, "DIR", OPT_TEXT, 0, 0, "a directory name", NULL, O(out_dir), 0, NULL, 0,
+     "results folder: DIR/cells.csv, DIR/cells/ID/ (default out/matrix-NAME); cells already in DIR/cells.csv are "
+     "not run again"},
+    {"--only", NULL, "GLOB", OPT_LIST, 0, 0, "a glob", NULL, O(only), O(n_only), NULL, 0,
+     "run only the cells whose id or scene/solver matches (repeatable; their reference runs too)"},
+    {"--dry-run", NULL, NULL, OPT_SWITCH, 0, 0, NULL, NULL, O(dry_run), 0, NULL, 0,
+     "check the matrix and list its cells with their ids, done or todo; write nothing"},
+    {"--jobs", NULL, "N", OPT_INT, 1, 1024, NULL, NULL, O(jobs), 0, NULL, 0,
+     "cells at a time per process (default 1: a cell uses its own threads)"},
+    {"--threads", NULL, "T", OPT_INT, 1, MPM_MAX_THREADS, "an integer number of threads", NULL, O(threads), 0, NULL, 0,
+     "threads of every cell, replacing defaults.threads (refused when the matrix has a threads axis)"},
+    {"--asset-dir", NULL, "DIR", OPT_TEXT, 0, 0, "a directory name", NULL, O(asset_dir), 0, NULL, 0,
+     "where the scenes' mesh files are, relative to the working directory (replaces defaults.asset_dir)"},
+    {"--check", NULL, NULL, OPT_SWITCH, 0, 0, NULL, NULL, O(check), 0, NULL, 0,
+     "afterwards judge every cell (stable, converged, no energy rise): DIR/check.csv; exit 3 when one failed"},
+    {NULL}};
+
+static void matrix_run_init(void *args)
 {
-    char *end = NULL;
-    long v = strtol(s, &end, 10);
-    if (!s[0] || *end || v < 1 || v > 1024) return mpm_error(MPM_EINPUT, "%s '%s': expected an integer 1..1024", flag, s);
-    *out = (int)v;
-    return MPM_OK;
+    MatrixRunOptions *o = args;
+    o->jobs = 1;
 }
 
-static int cmd_run(int argc, char **argv)
+static int matrix_run_cmd(void *args, const char *file, int *exit_code)
 {
-    if (argc < 4 || argv[3][0] == '-') return mpm_error(MPM_EINPUT, "matrix run: expected a matrix file (see: mpmbench --help)");
-    static const char *only[MAX_ONLY];
-    MatrixRunOptions o = {NULL, only, 0, 0, 1, NULL, 0, 0};
-    for (int i = 4; i < argc; ++i) {
-        const char *f = argv[i];
-        int has_val = i + 1 < argc;
-        if (!strcmp(f, "--dry-run")) {
-            o.dry_run = 1;
-            continue;
-        }
-        if (!strcmp(f, "--check")) {
-            o.check = 1;
-            continue;
-        }
-        if (strcmp(f, "--out") && strcmp(f, "--only") && strcmp(f, "--jobs") && strcmp(f, "--asset-dir") &&
-            strcmp(f, "--threads"))
-            return mpm_error(MPM_EINPUT, "matrix run: unknown option '%s' (see: mpmbench --help)", f);
-        if (!has_val) return mpm_error(MPM_EINPUT, "%s: missing value", f);
-        const char *v = argv[++i];
-        int st = MPM_OK;
-        if (!strcmp(f, "--out")) o.out_dir = v;
-        else if (!strcmp(f, "--asset-dir")) o.asset_dir = v;
-        else if (!strcmp(f, "--jobs")) st = parse_count(f, v, &o.jobs);
-        else if (!strcmp(f, "--threads")) st = parse_count(f, v, &o.threads);
-        else if (o.n_only >= MAX_ONLY) st = mpm_error(MPM_EINPUT, "--only: more than %d patterns", MAX_ONLY);
-        else only[o.n_only++] = v;
-        if (st) return st;
+    int failed = 0;
+    int st = matrix_run(file, args, &failed);
+    if (!st && failed) *exit_code = CLI_EXIT_CHECK_FAILED;
+    return st;
+}
+
+const Command matrix_run_command = {
+    .name = "matrix run",
+    .operand = "FILE",
+    .operand_missing = "a matrix file",
+    .summary = "Runs every cell of an experiment matrix (experiments/matrices/*.json) in a child process and appends "
+               "one row per finished cell to DIR/cells.csv; a rerun resumes.",
+    .notes = "Under mpirun -np K the cells spread over the K ranks. Exit status 0 when the matrix ran, whatever the\n"
+             "cells' statuses (they are in cells.csv); 2 for a bad matrix file or option; with --check, 3 when a\n"
+             "cell failed its check.\n",
+    .groups = {{matrix_run_options, 0, NULL, 0, NULL}},
+    .n_groups = 1,
+    .args_size = sizeof(MatrixRunOptions),
+    .init = matrix_run_init,
+    .run = matrix_run_cmd};
+
+/* The program to run: a path as given, a name looked up on PATH. */
+static int find_program(const char *name, char *out, size_t n)
+{
+    if (strchr(name, '/')) {
+        snprintf(out, n, "%s", name);
+        return access(out, X_OK) == 0;
     }
-    return matrix_run(argv[3], &o);
+    const char *path = getenv("PATH");
+    if (!path) path = "/usr/local/bin:/usr/bin:/bin";
+    while (*path) {
+        size_t len = strcspn(path, ":");
+        snprintf(out, n, "%.*s/%s", (int)len, len ? path : ".", name);
+        struct stat st;
+        if (stat(out, &st) == 0 && S_ISREG(st.st_mode) && access(out, X_OK) == 0) return 1;
+        path += len + (path[len] == ':');
+    }
+    return 0;
 }
 
 /* Replaces this process by the report script (its exit status and messages are the command's). */
-static int cmd_report(int argc, char **argv)
+static int matrix_report_cmd(void *args, const char *dir_arg, int *exit_code)
 {
-    if (argc < 4 || argv[3][0] == '-') return mpm_error(MPM_EINPUT, "matrix report: expected a result directory (see: mpmbench --help)");
+    (void)args, (void)exit_code;
     const char *python = getenv("MPM_PYTHON");
-    if (!python || !python[0]) python = "/usr/bin/python3";
+    if (!python || !python[0]) python = "python3";
     const char *dir = getenv("MPM_SCRIPT_DIR");
-    char script[1200];
+    char script[1200], program[4096];
     snprintf(script, sizeof script, "%s/matrix_report.py", dir && dir[0] ? dir : MPM_SOURCE_DIR "/scripts");
     struct stat st;
     if (stat(script, &st) != 0) return mpm_error(MPM_EINPUT, "matrix report: %s not found (set MPM_SCRIPT_DIR)", script);
-    if (access(python, X_OK) != 0)
-        return mpm_error(MPM_EINPUT, "matrix report: no %s (install python3 and python3-matplotlib: scripts/setup.sh)", python);
-    char **args = calloc((size_t)argc, sizeof *args);
-    if (!args) return mpm_error(MPM_EINTERNAL, "out of memory");
-    args[0] = (char *)python;
-    args[1] = script;
-    for (int i = 3; i < argc; ++i) args[i - 1] = argv[i];
+    if (!find_program(python, program, sizeof program))
+        return mpm_error(MPM_EINPUT,
+                         "matrix report: no %s%s (install python3 and matplotlib: scripts/setup.sh; or set MPM_PYTHON)",
+                         python, strchr(python, '/') ? "" : " on PATH");
+    char *argv[4] = {program, script, (char *)dir_arg, NULL};
     fflush(stdout);
     fflush(stderr);
-    execv(python, args);
-    free(args);
-    return mpm_error(MPM_EINTERNAL, "matrix report: cannot run %s", python);
+    execv(program, argv);
+    return mpm_error(MPM_EINTERNAL, "matrix report: cannot run %s", program);
 }
 
-int matrix_command(int argc, char **argv)
-{
-    if (argc < 3) return mpm_error(MPM_EINPUT, "matrix: expected 'run' or 'report' (see: mpmbench --help)");
-    if (!strcmp(argv[2], "run")) return cmd_run(argc, argv);
-    if (!strcmp(argv[2], "report")) return cmd_report(argc, argv);
-    return mpm_error(MPM_EINPUT, "matrix '%s': expected 'run' or 'report'", argv[2]);
-}
+const Command matrix_report_command = {
+    .name = "matrix report",
+    .operand = "DIR",
+    .operand_missing = "a result directory",
+    .summary = "Writes DIR/report.md with its tables and figures from a matrix run's results.",
+    .notes = "Runs scripts/matrix_report.py with the python3 found on PATH (a virtual environment with matplotlib\n"
+             "works), or with MPM_PYTHON (a program name or path); MPM_SCRIPT_DIR replaces the scripts folder.\n",
+    .run = matrix_report_cmd};

@@ -1,20 +1,17 @@
-/* `mpmbench matrix run|report`: the command line of the experiment-matrix
- * runner (experiments/matrix/matrix_run.h) and of its report
- * (scripts/matrix_report.py, run with /usr/bin/python3, whose Debian
- * matplotlib it needs; MPM_PYTHON and MPM_SCRIPT_DIR override both).
+/* `mpmbench matrix run FILE` and `mpmbench matrix report DIR`: the commands
+ * (experiments/cli/cli.h) of the experiment-matrix runner
+ * (experiments/matrix/matrix_run.h) and of its report
+ * (scripts/matrix_report.py). Their options and help are in matrix_cmd.c.
  *
- *   mpmbench matrix run FILE [--out DIR] [--only GLOB ...] [--dry-run]
- *                       [--jobs N] [--asset-dir DIR] [--check]
- *   mpmbench matrix report DIR
- *
- * --only GLOB (repeatable) keeps the cells whose id or "scene/solver"
- * matches; --jobs N runs N cells at a time per process (default 1: a cell
- * uses its own threads); --check decides pass or fail per cell
- * (experiments/matrix/matrix_check.h) and exits 1 when any failed. */
+ * The report runs with the python3 found on PATH (so a virtual environment
+ * with matplotlib works), or with MPM_PYTHON (a program name looked up on
+ * PATH, or a path); MPM_SCRIPT_DIR replaces the folder of the script. */
 #ifndef MPM_MATRIX_CMD_H
 #define MPM_MATRIX_CMD_H
 
-/* argv[1] is "matrix". */
-int matrix_command(int argc, char **argv);
+#include "experiments/cli/cli.h"
+
+extern const Command matrix_run_command;
+extern const Command matrix_report_command;
 
 #endif

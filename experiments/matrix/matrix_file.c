@@ -103,6 +103,26 @@ static int get_string(const Matrix *m, json_t *v, const char *path, char *out, s
     return MPM_OK;
 }
 
+const char *matrix_keep(Matrix *m, const char *text)
+{
+    if (m->n_pool == m->cap_pool) {
+        int cap = m->cap_pool ? 2 * m->cap_pool : 64;
+        char **p = realloc(m->pool, sizeof *p * (size_t)cap);
+        if (!p) return NULL;
+        m->pool = p;
+        m->cap_pool = cap;
+    }
+    char *copy = strdup(text);
+    if (copy) m->pool[m->n_pool++] = copy;
+    return copy;
+}
+
+static int keep(Matrix *m, const char *text, const char **out)
+{
+    *out = matrix_keep(m, text);
+    return *out ? MPM_OK : mpm_error(MPM_EINTERNAL, "out of memory");
+}
+
 void matrix_scene_path(const Matrix *m, const char *scene, char *out, size_t n)
 {
     size_t len = strlen(scene);
@@ -117,35 +137,95 @@ static int file_exists(const char *p)
     return stat(p, &st) == 0 && S_ISREG(st.st_mode);
 }
 
-static int get_scene(const Matrix *m, json_t *v, const char *path, char *out, size_t n)
+static int check_scene(const Matrix *m, const char *path, const char *scene)
 {
-    int st = get_string(m, v, path, out, n);
-    if (st) return st;
     char p[2048];
-    matrix_scene_path(m, out, p, sizeof p);
-    if (strcmp(p, out) == 0 && !strchr(out, '/')) { /* built-in name */
+    matrix_scene_path(m, scene, p, sizeof p);
+    if (strcmp(p, scene) == 0 && !strchr(scene, '/')) { /* built-in name */
         char f[2048];
-        snprintf(f, sizeof f, "%s/%s.json", scene_dir(), out);
+        snprintf(f, sizeof f, "%s/%s.json", scene_dir(), scene);
         if (!file_exists(f))
             return mpm_error(MPM_EINPUT, "%s: %s: unknown scene \"%s\" (not in %s; see: mpmbench list scenes)", m->base,
-                             path, out, scene_dir());
+                             path, scene, scene_dir());
     } else if (!file_exists(p)) {
-        return mpm_error(MPM_EINPUT, "%s: %s: scene file \"%s\" not found (%s)", m->base, path, out, p);
+        return mpm_error(MPM_EINPUT, "%s: %s: scene file \"%s\" not found (%s)", m->base, path, scene, p);
     }
     return MPM_OK;
 }
 
-static int get_solver(const Matrix *m, json_t *v, const char *path, char *out, size_t n)
+static int resolve_dir(const Matrix *m, const char *path, const char *given, char *out, size_t n)
 {
-    int st = get_string(m, v, path, out, n);
+    int w = given[0] == '/' ? snprintf(out, n, "%s", given) : snprintf(out, n, "%s/%s", m->dir, given);
+    if (w < 0 || (size_t)w >= n) return mpm_error(MPM_EINPUT, "%s: %s: path too long", m->base, path);
+    return MPM_OK;
+}
+
+/* The value of run setting o (not a list) at path: the JSON type and range
+ * its table line asks for, its check, and what the matrix file means by it
+ * (OPT_KEY_*). Texts are kept in the matrix's pool. */
+static int get_setting(Matrix *m, const Option *o, json_t *v, const char *path, OptionValue *out)
+{
+    char want[256];
+    option_expect(o, 1, want, sizeof want);
+    memset(out, 0, sizeof *out);
+    switch (o->type) {
+    case OPT_SWITCH:
+        if (!json_is_boolean(v)) return bad_value(m, path, v, "true or false");
+        out->i = json_is_true(v);
+        return MPM_OK;
+    case OPT_INT:
+        if (!json_is_integer(v) || !option_in_range(o, (double)json_integer_value(v))) return bad_value(m, path, v, want);
+        out->i = (int)json_integer_value(v);
+        return MPM_OK;
+    case OPT_REAL:
+        if (!json_is_number(v) || !option_in_range(o, json_number_value(v))) return bad_value(m, path, v, want);
+        out->d = json_number_value(v);
+        return MPM_OK;
+    case OPT_SIZE:
+        if (!json_is_number(v) || !option_in_range(o, json_number_value(v))) return bad_value(m, path, v, want);
+        out->z = (size_t)json_number_value(v);
+        return MPM_OK;
+    case OPT_CHOICE:
+        if (json_is_string(v))
+            for (int k = 0; o->choices[k]; ++k)
+                if (!strcmp(json_string_value(v), o->choices[k])) {
+                    out->i = k;
+                    return MPM_OK;
+                }
+        return bad_value(m, path, v, want);
+    case OPT_TEXT:
+        break;
+    case OPT_LIST:
+        return mpm_error(MPM_EINTERNAL, "%s: %s: a list setting read as one value", m->base, path);
+    }
+    if (o->flags & OPT_KEY_SUBDIR) { /* true: the folder named by the key in the cell's folder */
+        if (!json_is_boolean(v)) return bad_value(m, path, v, "true or false");
+        out->s = json_is_true(v) ? o->key : NULL;
+        return MPM_OK;
+    }
+    char text[1024], dir[1024];
+    int st = get_string(m, v, path, text, sizeof text);
     if (st) return st;
-    if (solver_spec_check(out, NULL, 0) != MPM_OK) {
+    if ((o->flags & OPT_KEY_SCENE) && (st = check_scene(m, path, text))) return st;
+    if (o->flags & OPT_KEY_DIR) {
+        if ((st = resolve_dir(m, path, text, dir, sizeof dir))) return st;
+        snprintf(text, sizeof text, "%s", dir);
+    }
+    if (o->check && o->check(text) != MPM_OK) {
         char msg[1024];
         snprintf(msg, sizeof msg, "%s", mpm_last_error());
         mpm_clear_error();
         return mpm_error(MPM_EINPUT, "%s: %s: %s", m->base, path, msg);
     }
-    return MPM_OK;
+    return keep(m, text, &out->s);
+}
+
+static int get_solver(Matrix *m, json_t *v, const char *path, const char **out)
+{
+    OptionValue val;
+    int st = get_setting(m, run_setting_by_key("solver"), v, path, &val);
+    *out = val.s;
+    return st;
 }
 
 /* A set / solver_opts object into key=value text, merged on top of `list`. */
@@ -202,21 +282,8 @@ static int get_kv(const Matrix *m, json_t *obj, const char *path, MatrixNamedKin
     return MPM_OK;
 }
 
-static int get_error_ref(const Matrix *m, json_t *v, const char *path, char *out, size_t n)
-{
-    int st = get_string(m, v, path, out, n);
-    if (st) return st;
-    if (error_ref_check(out) != MPM_OK) {
-        char msg[1024];
-        snprintf(msg, sizeof msg, "%s", mpm_last_error());
-        mpm_clear_error();
-        return mpm_error(MPM_EINPUT, "%s: %s: %s", m->base, path, msg);
-    }
-    return MPM_OK;
-}
-
 /* "reference": {"solver", "eps", "solver_opts"} (false per scene: none). */
-static int get_reference(const Matrix *m, json_t *v, const char *path, int allow_false, MatrixReference *r)
+static int get_reference(Matrix *m, json_t *v, const char *path, int allow_false, MatrixReference *r)
 {
     static const char *const keys[] = {"solver", "eps", "solver_opts", NULL};
     memset(r, 0, sizeof *r);
@@ -230,7 +297,7 @@ static int get_reference(const Matrix *m, json_t *v, const char *path, int allow
     json_t *s = json_object_get(v, "solver");
     join_path(p, sizeof p, path, "solver");
     if (!s) return mpm_error(MPM_EINPUT, "%s: %s: missing (required)", m->base, p);
-    if ((st = get_solver(m, s, p, r->solver, sizeof r->solver))) return st;
+    if ((st = get_solver(m, s, p, &r->solver)) || (st = keep(m, p, &r->solver_origin))) return st;
     r->eps = 1e-10;
     json_t *e = json_object_get(v, "eps");
     join_path(p, sizeof p, path, "eps");
@@ -242,117 +309,55 @@ static int get_reference(const Matrix *m, json_t *v, const char *path, int allow
     return MPM_OK;
 }
 
-static int resolve_dir(const Matrix *m, const char *path, const char *given, char *out, size_t n)
+/* The keys a settings object may have: every run setting with a key
+ * allowed there, then the matrix's own keys. NULL-terminated. */
+static void settings_keys(int per_scene, const char **keys)
 {
-    int w = given[0] == '/' ? snprintf(out, n, "%s", given) : snprintf(out, n, "%s/%s", m->dir, given);
-    if (w < 0 || (size_t)w >= n) return mpm_error(MPM_EINPUT, "%s: %s: path too long", m->base, path);
-    return MPM_OK;
-}
-
-/* The run limits and accuracy settings: shared by defaults and per-scene
- * entries. Returns 1 when key is one of them (st set), else 0. */
-static int get_run_setting(Matrix *m, const char *key, json_t *v, const char *p, MatrixSettings *s, int *st)
-{
-    if (!strcmp(key, "error_ref")) {
-        *st = get_error_ref(m, v, p, s->error_ref, sizeof s->error_ref);
-        s->has_error_ref = 1;
-    } else if (!strcmp(key, "trajectory")) {
-        *st = get_bool(m, v, p, &s->trajectory);
-        s->has_trajectory = 1;
-    } else if (!strcmp(key, "max_outer") || !strcmp(key, "max_linear")) {
-        int outer = !strcmp(key, "max_outer");
-        *st = get_int(m, v, p, 1, outer ? &s->max_outer : &s->max_linear);
-        if (outer) s->has_max_outer = 1;
-        else s->has_max_linear = 1;
-    } else if (!strcmp(key, "max_step_seconds") || !strcmp(key, "max_run_seconds")) {
-        int step = !strcmp(key, "max_step_seconds");
-        double *dst = step ? &s->max_step_s : &s->max_run_s;
-        *st = get_positive(m, v, p, dst);
-        if (!*st && *dst > 1e9) *st = bad_value(m, p, v, "seconds in (0, 1e9]");
-        if (step) s->has_max_step_s = 1;
-        else s->has_max_run_s = 1;
-    } else if (!strcmp(key, "on_failure")) {
-        *st = get_string(m, v, p, s->on_failure, sizeof s->on_failure);
-        if (!*st && strcmp(s->on_failure, "stop") && strcmp(s->on_failure, "continue"))
-            *st = bad_value(m, p, v, "\"stop\" or \"continue\"");
-        s->has_on_failure = 1;
-    } else if (!strcmp(key, "reference")) {
-        *st = get_reference(m, v, p, 1, &s->reference);
-        s->has_reference = 1;
-    } else {
-        return 0;
+    int n = 0;
+    for (int k = 0; k < run_settings_count; ++k) {
+        const Option *o = &run_settings[k];
+        if (o->key && (o->flags & (per_scene ? OPT_IN_SCENES : OPT_IN_DEFAULTS))) keys[n++] = o->key;
     }
-    return 1;
+    keys[n++] = "first_timed_frame";
+    if (per_scene) keys[n++] = "reference";
+    keys[n] = NULL;
 }
 
-/* defaults (every key) or a per-scene entry (scale, frames, first_timed_frame,
- * set, the run limits, error_ref, reference). */
+/* "defaults" or a per-scene entry "scenes.NAME". */
 static int get_settings(Matrix *m, json_t *obj, const char *path, int per_scene, MatrixSettings *s)
 {
-    static const char *const all[] = {"scene",     "solver",     "eps",        "scale",           "threads",
-                                      "frames",    "first_timed_frame", "set", "solver_opts",     "history",
-                                      "armijo",    "particles",  "asset_dir",  "error_ref",       "trajectory",
-                                      "max_outer", "max_linear", "max_step_seconds", "max_run_seconds", "on_failure",
-                                      NULL};
-    static const char *const scene_keys[] = {"scale",      "frames",           "first_timed_frame", "set",
-                                             "error_ref",  "max_outer",        "max_linear",        "max_step_seconds",
-                                             "max_run_seconds", "on_failure",  "reference",         NULL};
+    const char *keys[RUN_SETTINGS_MAX + 3];
+    settings_keys(per_scene, keys);
     if (!json_is_object(obj)) return bad_value(m, path, obj, "an object");
-    int st = check_keys(m, obj, path, per_scene ? scene_keys : all);
+    int st = check_keys(m, obj, path, keys);
     if (st) return st;
     const char *key;
     json_t *v;
     json_object_foreach(obj, key, v) {
         char p[256];
         join_path(p, sizeof p, path, key);
-        if (get_run_setting(m, key, v, p, s, &st)) {
-            if (st) return st;
-            continue;
-        }
-        if (!strcmp(key, "scene")) {
-            st = get_scene(m, v, p, s->scene, sizeof s->scene);
-            snprintf(s->scene_origin, sizeof s->scene_origin, "%s", p);
-            s->has_scene = 1;
-        } else if (!strcmp(key, "solver")) {
-            st = get_solver(m, v, p, s->solver, sizeof s->solver);
-            snprintf(s->solver_origin, sizeof s->solver_origin, "%s", p);
-            s->has_solver = 1;
-        } else if (!strcmp(key, "eps")) {
-            st = get_positive(m, v, p, &s->eps);
-            s->has_eps = 1;
-        } else if (!strcmp(key, "scale")) {
-            st = get_positive(m, v, p, &s->scale);
-            s->has_scale = 1;
-        } else if (!strcmp(key, "threads")) {
-            st = get_int(m, v, p, 1, &s->threads);
-            s->has_threads = 1;
-        } else if (!strcmp(key, "frames")) {
-            st = get_int(m, v, p, 1, &s->frames);
-            s->has_frames = 1;
+        int k = run_setting_index(key);
+        if (k >= 0 && run_settings[k].type == OPT_LIST) {
+            st = get_kv(m, v, p, run_settings[k].flags & OPT_KEY_JSON ? MATRIX_SET : MATRIX_SOLVER_OPTS,
+                        run_settings[k].flags & OPT_KEY_JSON ? &s->set : &s->solver_opts);
+            if (!st && !(st = keep(m, p, &s->origin[k]))) s->given |= 1ull << k;
+        } else if (k >= 0) {
+            OptionValue val;
+            if (!(st = get_setting(m, &run_settings[k], v, p, &val)) && !(st = keep(m, p, &s->origin[k]))) {
+                option_set(&run_settings[k], &s->run, &val);
+                s->given |= 1ull << k;
+            }
         } else if (!strcmp(key, "first_timed_frame")) {
             st = get_int(m, v, p, 0, &s->first_timed_frame);
             s->has_first = 1;
-        } else if (!strcmp(key, "set")) {
-            st = get_kv(m, v, p, MATRIX_SET, &s->set);
-        } else if (!strcmp(key, "solver_opts")) {
-            st = get_kv(m, v, p, MATRIX_SOLVER_OPTS, &s->solver_opts);
-        } else if (!strcmp(key, "history")) {
-            st = get_bool(m, v, p, &s->history);
-            s->has_history = 1;
-        } else if (!strcmp(key, "armijo")) {
-            st = get_bool(m, v, p, &s->armijo);
-            s->has_armijo = 1;
-        } else if (!strcmp(key, "particles")) {
-            st = get_bool(m, v, p, &s->particles);
-            s->has_particles = 1;
-        } else if (!strcmp(key, "asset_dir")) {
-            char given[1024];
-            if (!(st = get_string(m, v, p, given, sizeof given))) st = resolve_dir(m, p, given, s->asset_dir, sizeof s->asset_dir);
-            s->has_asset_dir = 1;
+        } else if (!strcmp(key, "reference")) {
+            st = get_reference(m, v, p, 1, &s->reference);
+            s->has_reference = 1;
         }
         if (st) return st;
     }
-    if (s->has_frames && s->has_first && s->first_timed_frame >= s->frames) {
+    int kf = run_setting_index("frames");
+    if ((s->given >> kf & 1) && s->has_first && s->first_timed_frame >= s->run.frames) {
         char p[256];
         join_path(p, sizeof p, path, "first_timed_frame");
         return bad_value(m, p, json_object_get(obj, "first_timed_frame"), "a frame before \"frames\"");
@@ -457,61 +462,39 @@ static int get_named_axes(Matrix *m, json_t *obj, const char *path, MatrixNamedK
     return MPM_OK;
 }
 
+static int is_axis(int k) { return k >= 0 && (run_settings[k].flags & OPT_AXIS); }
+
 static int get_axes(Matrix *m, json_t *axes)
 {
-    static const char *const keys[] = {"scene", "solver", "eps", "scale", "threads", "error_ref", "sets", "solver_opts",
-                                       NULL};
+    const char *keys[RUN_SETTINGS_MAX + 3];
+    int n_keys = 0;
+    for (int k = 0; k < run_settings_count; ++k)
+        if (is_axis(k)) keys[n_keys++] = run_settings[k].key;
+    keys[n_keys++] = "sets";
+    keys[n_keys++] = "solver_opts";
+    keys[n_keys] = NULL;
     if (!json_is_object(axes)) return bad_value(m, "axes", axes, "an object");
     int st = check_keys(m, axes, "axes", keys);
     if (st) return st;
-    json_t *v;
-    size_t n;
-    char p[64];
-    if ((v = json_object_get(axes, "scene"))) {
-        if ((st = get_list(m, v, "axes.scene", &n))) return st;
-        if (!(m->scenes = calloc(n, sizeof *m->scenes))) return mpm_error(MPM_EINTERNAL, "out of memory");
-        for (size_t i = 0; i < n; ++i, m->n_scenes++) {
-            snprintf(p, sizeof p, "axes.scene[%zu]", i);
-            if ((st = get_scene(m, json_array_get(v, i), p, m->scenes[i], sizeof m->scenes[i]))) return st;
-        }
-    }
-    if ((v = json_object_get(axes, "solver"))) {
-        if ((st = get_list(m, v, "axes.solver", &n))) return st;
-        if (!(m->solvers = calloc(n, sizeof *m->solvers))) return mpm_error(MPM_EINTERNAL, "out of memory");
-        for (size_t i = 0; i < n; ++i, m->n_solvers++) {
-            snprintf(p, sizeof p, "axes.solver[%zu]", i);
-            if ((st = get_solver(m, json_array_get(v, i), p, m->solvers[i], sizeof m->solvers[i]))) return st;
-        }
-    }
-    const char *num_keys[2] = {"eps", "scale"};
-    double **num_out[2] = {&m->eps, &m->scales};
-    int *num_n[2] = {&m->n_eps, &m->n_scales};
-    for (int k = 0; k < 2; ++k) {
-        if (!(v = json_object_get(axes, num_keys[k]))) continue;
-        snprintf(p, sizeof p, "axes.%s", num_keys[k]);
+    for (int k = 0; k < run_settings_count; ++k) {
+        json_t *v = is_axis(k) ? json_object_get(axes, run_settings[k].key) : NULL;
+        if (!v) continue;
+        char p[300];
+        size_t n = 0;
+        snprintf(p, sizeof p, "axes.%s", run_settings[k].key);
         if ((st = get_list(m, v, p, &n))) return st;
-        if (!(*num_out[k] = calloc(n, sizeof(double)))) return mpm_error(MPM_EINTERNAL, "out of memory");
-        for (size_t i = 0; i < n; ++i, (*num_n[k])++) {
-            snprintf(p, sizeof p, "axes.%s[%zu]", num_keys[k], i);
-            if ((st = get_positive(m, json_array_get(v, i), p, &(*num_out[k])[i]))) return st;
+        MatrixAxis *a = &m->axis[k];
+        a->values = calloc(n, sizeof *a->values);
+        a->origins = calloc(n, sizeof *a->origins);
+        if (!a->values || !a->origins) return mpm_error(MPM_EINTERNAL, "out of memory");
+        for (size_t i = 0; i < n; ++i, a->n++) {
+            snprintf(p, sizeof p, "axes.%s[%zu]", run_settings[k].key, i);
+            if ((st = get_setting(m, &run_settings[k], json_array_get(v, i), p, &a->values[i])) ||
+                (st = keep(m, p, &a->origins[i])))
+                return st;
         }
     }
-    if ((v = json_object_get(axes, "threads"))) {
-        if ((st = get_list(m, v, "axes.threads", &n))) return st;
-        if (!(m->threads = calloc(n, sizeof *m->threads))) return mpm_error(MPM_EINTERNAL, "out of memory");
-        for (size_t i = 0; i < n; ++i, m->n_threads++) {
-            snprintf(p, sizeof p, "axes.threads[%zu]", i);
-            if ((st = get_int(m, json_array_get(v, i), p, 1, &m->threads[i]))) return st;
-        }
-    }
-    if ((v = json_object_get(axes, "error_ref"))) {
-        if ((st = get_list(m, v, "axes.error_ref", &n))) return st;
-        if (!(m->error_refs = calloc(n, sizeof *m->error_refs))) return mpm_error(MPM_EINTERNAL, "out of memory");
-        for (size_t i = 0; i < n; ++i, m->n_error_refs++) {
-            snprintf(p, sizeof p, "axes.error_ref[%zu]", i);
-            if ((st = get_error_ref(m, json_array_get(v, i), p, m->error_refs[i], sizeof m->error_refs[i]))) return st;
-        }
-    }
+    json_t *v;
     if ((v = json_object_get(axes, "sets")) && (st = get_named_axes(m, v, "axes.sets", MATRIX_SET))) return st;
     if ((v = json_object_get(axes, "solver_opts")) &&
         (st = get_named_axes(m, v, "axes.solver_opts", MATRIX_SOLVER_OPTS)))
@@ -526,25 +509,24 @@ int matrix_named_index(const Matrix *m, const char *name)
     return -1;
 }
 
-/* Does the matrix have `text` as a value of the string axis `key`? */
+int matrix_axis_length(const Matrix *m, const char *key)
+{
+    int k = run_setting_index(key);
+    return k >= 0 ? m->axis[k].n : 0;
+}
+
+/* Does the matrix have `text` as a value of the text setting k (its axis, or
+ * else the defaults' value) or of the named axis `key` (a label)? */
 static int has_string_value(const Matrix *m, const char *key, const char *text)
 {
-    if (!strcmp(key, "scene")) {
-        if (!m->n_scenes) return m->defaults.has_scene && !strcmp(m->defaults.scene, text);
-        for (int i = 0; i < m->n_scenes; ++i)
-            if (!strcmp(m->scenes[i], text)) return 1;
-        return 0;
-    }
-    if (!strcmp(key, "solver")) {
-        if (!m->n_solvers) return m->defaults.has_solver && !strcmp(m->defaults.solver, text);
-        for (int i = 0; i < m->n_solvers; ++i)
-            if (!strcmp(m->solvers[i], text)) return 1;
-        return 0;
-    }
-    if (!strcmp(key, "error_ref")) {
-        if (!m->n_error_refs) return m->defaults.has_error_ref && !strcmp(m->defaults.error_ref, text);
-        for (int i = 0; i < m->n_error_refs; ++i)
-            if (!strcmp(m->error_refs[i], text)) return 1;
+    int k = run_setting_index(key);
+    if (k >= 0) {
+        const MatrixAxis *a = &m->axis[k];
+        OptionValue d;
+        option_get(&run_settings[k], &m->defaults.run, &d);
+        if (!a->n) return (m->defaults.given >> k & 1) && d.s && !strcmp(d.s, text);
+        for (int i = 0; i < a->n; ++i)
+            if (!strcmp(a->values[i].s, text)) return 1;
         return 0;
     }
     const MatrixNamedAxis *a = &m->named[matrix_named_index(m, key)];
@@ -553,19 +535,16 @@ static int has_string_value(const Matrix *m, const char *key, const char *text)
     return 0;
 }
 
-/* One rule value: the right type, and a value the matrix has. */
-static int check_rule_value(const Matrix *m, const char *key, json_t *v, const char *path)
+/* One rule value: the right type, and (texts, labels) a value the matrix has. */
+static int check_rule_value(Matrix *m, const char *key, json_t *v, const char *path)
 {
-    if (!strcmp(key, "eps") || !strcmp(key, "scale")) {
-        double x;
-        return get_positive(m, v, path, &x);
-    }
-    if (!strcmp(key, "threads")) {
-        int t;
-        return get_int(m, v, path, 1, &t);
+    int k = run_setting_index(key);
+    if (k >= 0 && run_settings[k].type != OPT_TEXT) {
+        OptionValue x;
+        return get_setting(m, &run_settings[k], v, path, &x);
     }
     char text[256];
-    if (json_is_number(v) && strcmp(key, "scene") && strcmp(key, "solver") && strcmp(key, "error_ref"))
+    if (json_is_number(v) && k < 0)
         matrix_format_number(json_number_value(v), text, sizeof text);
     else if (!json_is_string(v))
         return bad_value(m, path, v, "a string (a value of that axis)");
@@ -589,13 +568,14 @@ static int get_rules(Matrix *m, json_t *rules, const char *path)
         json_object_foreach(r, key, v) {
             char p[160];
             snprintf(p, sizeof p, "%s.%s", rp, key);
-            static const char *const fixed[] = {"scene", "solver", "eps", "scale", "threads", "error_ref"};
-            int known = matrix_named_index(m, key) >= 0;
-            for (int k = 0; k < 6; ++k) known |= !strcmp(key, fixed[k]);
-            if (!known)
-                return mpm_error(MPM_EINPUT,
-                                 "%s: %s: unknown axis \"%s\" (scene, solver, eps, scale, threads, error_ref or a named axis)",
-                                 m->base, rp, key);
+            if (matrix_named_index(m, key) < 0 && !is_axis(run_setting_index(key))) {
+                char axes[256] = "";
+                size_t len = 0;
+                for (int k = 0; k < run_settings_count && len < sizeof axes; ++k)
+                    if (is_axis(k)) len += (size_t)snprintf(axes + len, sizeof axes - len, "%s, ", run_settings[k].key);
+                if (len >= 2 && len < sizeof axes) axes[len - 2] = '\0';
+                return mpm_error(MPM_EINPUT, "%s: %s: unknown axis \"%s\" (%s or a named axis)", m->base, rp, key, axes);
+            }
             int st;
             if (json_is_array(v)) {
                 if (!json_array_size(v)) return bad_value(m, p, v, "a value or a non-empty list");
@@ -632,10 +612,11 @@ static int get_top(Matrix *m)
     }
     if ((v = json_object_get(root, "defaults")) && (st = get_settings(m, v, "defaults", 0, &m->defaults))) return st;
     if ((v = json_object_get(root, "axes")) && (st = get_axes(m, v))) return st;
-    if (!m->n_scenes && !m->defaults.has_scene)
-        return mpm_error(MPM_EINPUT, "%s: axes.scene: missing (give axes.scene or defaults.scene)", m->base);
-    if (!m->n_solvers && !m->defaults.has_solver)
-        return mpm_error(MPM_EINPUT, "%s: axes.solver: missing (give axes.solver or defaults.solver)", m->base);
+    for (int k = 0; k < run_settings_count; ++k) /* a cell names its scene and solver */
+        if ((run_settings[k].flags & OPT_ARGV_ALWAYS) && run_settings[k].type == OPT_TEXT && !m->axis[k].n &&
+            !(m->defaults.given >> k & 1))
+            return mpm_error(MPM_EINPUT, "%s: axes.%s: missing (give axes.%s or defaults.%s)", m->base,
+                             run_settings[k].key, run_settings[k].key, run_settings[k].key);
     if ((v = json_object_get(root, "scenes"))) {
         if (!json_is_object(v)) return bad_value(m, "scenes", v, "an object {scene: settings}");
         if (!(m->per_scene = calloc(json_object_size(v) + 1, sizeof *m->per_scene)))
@@ -655,10 +636,11 @@ static int get_top(Matrix *m)
     if ((v = json_object_get(root, "reference")) && (st = get_reference(m, v, "reference", 0, &m->reference)))
         return st;
     m->has_references = m->reference.has;
-    m->uses_error_ref = m->defaults.has_error_ref || m->n_error_refs > 0;
+    int ke = run_setting_index("error_ref");
+    m->uses_error_ref = (m->defaults.given >> ke & 1) || m->axis[ke].n > 0;
     for (int i = 0; i < m->n_per_scene; ++i) {
         const MatrixSettings *ps = &m->per_scene[i].s;
-        m->uses_error_ref |= ps->has_error_ref;
+        m->uses_error_ref |= ps->given >> ke & 1;
         m->has_references |= ps->has_reference && ps->reference.has;
     }
     if ((v = json_object_get(root, "include"))) {
@@ -670,7 +652,9 @@ static int get_top(Matrix *m)
         m->exclude = v;
     }
     if ((v = json_object_get(root, "baseline"))) {
-        if ((st = get_solver(m, v, "baseline", m->baseline, sizeof m->baseline))) return st;
+        const char *baseline;
+        if ((st = get_solver(m, v, "baseline", &baseline))) return st;
+        snprintf(m->baseline, sizeof m->baseline, "%s", baseline);
         if (!has_string_value(m, "solver", m->baseline))
             return mpm_error(MPM_EINPUT, "%s: baseline: \"%s\" is not a solver of the matrix", m->base, m->baseline);
     }
@@ -707,12 +691,12 @@ int matrix_load(const char *path, Matrix *m)
 
 void matrix_free(Matrix *m)
 {
-    free(m->scenes);
-    free(m->solvers);
-    free(m->eps);
-    free(m->scales);
-    free(m->threads);
-    free(m->error_refs);
+    for (int k = 0; k < RUN_SETTINGS_MAX; ++k) {
+        free(m->axis[k].values);
+        free(m->axis[k].origins);
+    }
+    for (int i = 0; i < m->n_pool; ++i) free(m->pool[i]);
+    free(m->pool);
     for (int i = 0; i < m->n_named; ++i) free(m->named[i].values);
     free(m->per_scene);
     json_decref(m->root);

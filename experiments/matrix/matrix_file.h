@@ -4,7 +4,11 @@
  * plots. This file loads and validates the matrix file.
  *
  * ------------------------------------------------------------------------
- * Matrix file format. Unknown keys anywhere are errors.
+ * Matrix file format. Unknown keys anywhere are errors. The keys of "defaults",
+ * "scenes.NAME" and "axes" that are run settings, their types, ranges and
+ * where each may stand come from the one table of run settings
+ * (experiments/cli/run_settings.c; `mpmbench run --help` names the keys);
+ * the list below describes them.
  * ------------------------------------------------------------------------
  * {
  *   "name": "stiffness",            required: 1-63 of [A-Za-z0-9_.-]; the
@@ -15,7 +19,7 @@
  *                                   from the matrix file's directory)
  *     "solver": "hot",              preset name (mpmbench list solvers)
  *     "eps": 1e-7, "scale": 1.86,   > 0 (defaults 1e-7 and 1)
- *     "threads": 2,                 integer >= 1 (default: OpenMP's)
+ *     "threads": 2,                 integer in [1, 1024] (default: OpenMP's)
  *     "frames": 5,                  integer >= 1 (default: the scene's)
  *     "first_timed_frame": 0,       integer >= 0, < frames: frames before it
  *                                   are simulated but not timed (a pusher that
@@ -35,8 +39,8 @@
  *     "trajectory": false,          --trajectory (OUT/trajectory.bin)
  *     "max_outer": 10000,           --max-outer, integer >= 1
  *     "max_linear": 10000,          --max-linear, integer >= 1
- *     "max_step_seconds": 30,       --max-step-seconds, > 0
- *     "max_run_seconds": 600,       --max-run-seconds, > 0
+ *     "max_step_seconds": 30,       --max-step-seconds, in (0, 1e9]
+ *     "max_run_seconds": 600,       --max-run-seconds, in (0, 1e9]
  *     "on_failure": "stop"          --on-failure stop | continue
  *   },
  *   "axes": {                       optional: lists of values; the cells are
@@ -107,6 +111,8 @@
 
 #include <jansson.h>
 
+#include "experiments/cli/run_settings.h"
+
 #define MATRIX_MAX_KV 32       /* entries of one merged set / solver_opts */
 #define MATRIX_MAX_AXES 16     /* named axes */
 
@@ -139,34 +145,40 @@ typedef struct {
 /* The reference run of a scene ("reference"). */
 typedef struct {
     int has;                  /* 0: none (absent, or false per scene) */
-    char solver[128];
+    const char *solver;       /* in the matrix's text pool */
     double eps;
     MatrixKvList solver_opts;
     char origin[200];         /* where it was given, for messages */
+    const char *solver_origin;
 } MatrixReference;
 
-/* One optional setting (has = given). */
+/* The settings given in "defaults" or in "scenes.NAME". The run settings
+ * (experiments/cli/run_settings.h) are in `run`, bit k of `given` saying
+ * whether run_settings[k] was given and origin[k] where; texts live in the
+ * matrix's text pool; the list settings are in set and solver_opts (with
+ * where each entry came from). The rest are the matrix's own keys. */
 typedef struct {
-    int has_scene, has_solver, has_eps, has_scale, has_threads, has_frames, has_first, has_history, has_armijo,
-        has_particles, has_asset_dir, has_error_ref, has_trajectory, has_max_outer, has_max_linear, has_max_step_s,
-        has_max_run_s, has_on_failure, has_reference;
-    char scene[1024], solver[128];
-    char scene_origin[256], solver_origin[256];
-    double eps, scale;
-    int threads, frames, first_timed_frame, history, armijo, particles, trajectory;
-    char asset_dir[1024];     /* absolute when given */
-    char error_ref[160];      /* SOLVER[:eps] | auto[:eps] */
-    int max_outer, max_linear;
-    double max_step_s, max_run_s;
-    char on_failure[16];      /* "stop" | "continue" */
-    MatrixReference reference;
+    RunConfig run;
+    unsigned long long given;
+    const char *origin[RUN_SETTINGS_MAX];
     MatrixKvList set, solver_opts;
+    int has_first, first_timed_frame;
+    int has_reference;
+    MatrixReference reference;
 } MatrixSettings;
 
 typedef struct {
     char scene[1024];         /* as in the scene axis */
-    MatrixSettings s;         /* only scale, frames, first_timed_frame, set */
+    MatrixSettings s;         /* only the keys allowed per scene */
 } MatrixSceneSettings;
+
+/* The values of an axis of a run setting ("axes.eps": [...]), with where each
+ * was given. */
+typedef struct {
+    OptionValue *values;
+    const char **origins;
+    int n;                    /* 0: not an axis (the defaults' value) */
+} MatrixAxis;
 
 typedef struct {
     char file[1024];          /* as given */
@@ -175,17 +187,7 @@ typedef struct {
     char name[64];
     char description[1024];
     MatrixSettings defaults;
-    /* fixed axes: NULL / 0 = not an axis (the defaults' value) */
-    char (*scenes)[1024];
-    int n_scenes;
-    char (*solvers)[128];
-    int n_solvers;
-    double *eps, *scales;
-    int n_eps, n_scales;
-    int *threads;
-    int n_threads;
-    char (*error_refs)[160];
-    int n_error_refs;
+    MatrixAxis axis[RUN_SETTINGS_MAX]; /* axis[k]: of run_settings[k] (OPT_AXIS ones) */
     MatrixNamedAxis named[MATRIX_MAX_AXES];
     int n_named;
     MatrixSceneSettings *per_scene;
@@ -198,6 +200,8 @@ typedef struct {
     int has_references;           /* some scene has a reference run */
     int uses_error_ref;           /* error_ref given anywhere: a cells.csv column */
     json_t *root;                 /* the parsed file */
+    char **pool;                  /* the texts the settings point to */
+    int n_pool, cap_pool;
 } Matrix;
 
 /* Loads and validates the file (structure, types, names of scenes and
@@ -208,6 +212,10 @@ void matrix_free(Matrix *m);
 
 /* Index of the named axis, or -1. */
 int matrix_named_index(const Matrix *m, const char *name);
+/* Values of the axis of a run setting ("threads"), 0 when it is not an axis. */
+int matrix_axis_length(const Matrix *m, const char *key);
+/* A copy of text owned by the matrix (freed by matrix_free); NULL when out of memory. */
+const char *matrix_keep(Matrix *m, const char *text);
 
 /* Shortest text that reads back as the same double ("1e+05", "0.5"). */
 void matrix_format_number(double v, char *out, size_t n);

@@ -76,16 +76,16 @@ int matrix_results_row(const Matrix *m, const MatrixCell *c, const CellOutcome *
 {
     size_t len = 0;
     char eps[32], scale[32], threads[16], frames[16], first[16], text[4096];
-    matrix_format_number(c->eps, eps, sizeof eps);
-    matrix_format_number(c->scale, scale, sizeof scale);
-    snprintf(threads, sizeof threads, "%d", c->threads);
-    snprintf(frames, sizeof frames, "%d", c->frames);
+    matrix_format_number(c->run.eps, eps, sizeof eps);
+    matrix_format_number(c->run.scale, scale, sizeof scale);
+    snprintf(threads, sizeof threads, "%d", c->run.threads);
+    snprintf(frames, sizeof frames, "%d", c->run.frames);
     snprintf(first, sizeof first, "%d", c->first_timed_frame);
-    const char *fixed[] = {c->id, c->scene, c->solver, eps, scale, threads, frames, first};
+    const char *fixed[] = {c->id, c->run.scene, c->run.solver, eps, scale, threads, frames, first};
     int bad = 0;
     out[0] = '\0';
     for (int i = 0; i < 8; ++i) bad |= put(out, cap, &len, fixed[i], i == 0);
-    if (m->uses_error_ref) bad |= put(out, cap, &len, c->error_ref, 0);
+    if (m->uses_error_ref) bad |= put(out, cap, &len, c->run.error_ref ? c->run.error_ref : "", 0);
     for (int a = 0; a < m->n_named; ++a) bad |= put(out, cap, &len, m->named[a].values[c->value[a]].label, 0);
     if (m->has_references) {
         bad |= put(out, cap, &len, c->is_reference ? "reference" : "cell", 0);

@@ -7,9 +7,11 @@
  * 0 validates, prints and writes, the others only run cells.
  *
  * Output on stdout: one line per finished cell; on a terminal (stderr, CI
- * unset) also a progress line. Exit status 0 when the matrix ran (whatever
- * the cells' statuses: they are in cells.csv), 2 for a bad matrix file or
- * flag; with --check, 1 when a cell failed its check (matrix_check.h).
+ * unset) also a progress line. MPM_OK when the matrix ran (whatever the
+ * cells' statuses: they are in cells.csv), MPM_EINPUT for a bad matrix file
+ * or flag; with --check, *failed gets the number of cells that failed their
+ * check (matrix_check.h; one line on stderr says so), which the command
+ * turns into exit status 3.
  *
  * A cell with a reference run (matrix_file.h "reference") is dispatched
  * only after its reference ended ok; when the reference did not, the cell
@@ -18,9 +20,11 @@
 #ifndef MPM_MATRIX_RUN_H
 #define MPM_MATRIX_RUN_H
 
+#define MATRIX_MAX_ONLY 64
+
 typedef struct {
     const char *out_dir;              /* NULL: out/matrix-NAME */
-    const char *const *only;          /* globs on the cell id or "scene/solver" */
+    const char *only[MATRIX_MAX_ONLY]; /* globs on the cell id or "scene/solver" */
     int n_only;
     int dry_run;                      /* list the cells and what is done */
     int jobs;                         /* cells at a time per process (>= 1) */
@@ -29,7 +33,7 @@ typedef struct {
     int check;                        /* --check: the stability verdict of every cell (matrix_check.h) */
 } MatrixRunOptions;
 
-int matrix_run(const char *file, const MatrixRunOptions *o);
+int matrix_run(const char *file, const MatrixRunOptions *o, int *failed);
 
 /* Was this process started by an MPI launcher (mpirun, srun with PMI/PMIx)? */
 int matrix_under_mpi_launcher(void);

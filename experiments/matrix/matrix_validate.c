@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "core/scene.h"
 #include "experiments/run/registry.h"
+#include "experiments/run/run.h"
 #include "solvers/solver.h"
 
 /* Replaces the recorded message by "prefix: message", keeping the status. */
@@ -70,34 +71,31 @@ static void seen_free(Seen *s)
 
 static int check_scene(const Matrix *m, const MatrixCell *c)
 {
-    SceneOverride ov[MATRIX_MAX_KV];
-    for (int i = 0; i < c->n_set; ++i) {
-        ov[i].key = c->set[i].key;
-        ov[i].value = c->set[i].value;
-        if (strlen(c->set[i].key) + strlen(c->set[i].value) + 2 > 256)
-            return mpm_error(MPM_EINPUT, "%s: %s: set %s=%s: longer than --set takes (255 characters)", m->base,
-                             c->set[i].origin, c->set[i].key, c->set[i].value);
-    }
-    char path[2048];
-    matrix_scene_path(m, c->scene, path, sizeof path);
-    SceneLoadOptions lo = {.scale = c->scale, .overrides = ov, .n_overrides = c->n_set,
-                           .asset_dir = c->asset_dir[0] ? c->asset_dir : NULL};
+    for (int i = 0; i < c->n_set; ++i)
+        if (strlen(c->set[i].key) + strlen(c->set[i].value) + 2 > RUN_SET_TEXT)
+            return mpm_error(MPM_EINPUT, "%s: %s: set %s=%s: longer than --set takes (%d characters)", m->base,
+                             c->set[i].origin, c->set[i].key, c->set[i].value, RUN_SET_TEXT - 1);
+    /* the scene as the cell's run loads it */
+    static MatrixCellTexts texts;
+    RunConfig cfg;
+    int st = matrix_cell_config(m, c, "", &cfg, &texts);
+    if (st) return st;
     Scene sc;
-    int st = scene_load(path, &lo, &sc);
+    st = run_scene_load(&cfg, &sc);
     int frames = sc.frames;
     scene_free(&sc);
     char scale[32], prefix[2048];
-    matrix_format_number(c->scale, scale, sizeof scale);
+    matrix_format_number(c->run.scale, scale, sizeof scale);
     if (st) {
         char sets[1024];
         kv_text(c->set, c->n_set, 1, sets, sizeof sets);
-        snprintf(prefix, sizeof prefix, "%s: scene \"%s\" (%s) at scale %s%s%s", m->base, c->scene, c->scene_origin,
+        snprintf(prefix, sizeof prefix, "%s: scene \"%s\" (%s) at scale %s%s%s", m->base, c->run.scene, c->origin[run_setting_index("scene")],
                  scale, c->n_set ? " with set " : "", sets);
         return wrap_error(st, prefix);
     }
-    if (!c->frames && c->first_timed_frame >= frames)
+    if (!c->run.frames && c->first_timed_frame >= frames)
         return mpm_error(MPM_EINPUT, "%s: scene \"%s\": first_timed_frame %d is not before the scene's %d frames",
-                         m->base, c->scene, c->first_timed_frame, frames);
+                         m->base, c->run.scene, c->first_timed_frame, frames);
     return MPM_OK;
 }
 
@@ -109,22 +107,23 @@ int matrix_validate_cells(const Matrix *m, const MatrixCells *cells, const int *
         const MatrixCell *c = &cells->cells[i];
         char key[4096], opts[2048];
         kv_text(c->solver_opts, c->n_solver_opts, 0, opts, sizeof opts);
-        snprintf(key, sizeof key, "%s|%s", c->solver, opts);
+        snprintf(key, sizeof key, "%s|%s", c->run.solver, opts);
         int fresh = seen_add(&solvers, key);
         if (fresh < 0) st = mpm_error(MPM_EINTERNAL, "out of memory");
-        if (fresh > 0 && (st = matrix_check_solver(c->solver, c->solver_opts, c->n_solver_opts))) {
+        if (fresh > 0 && (st = matrix_check_solver(c->run.solver, c->solver_opts, c->n_solver_opts))) {
             char with[2048], prefix[2600];
             kv_text(c->solver_opts, c->n_solver_opts, 1, with, sizeof with);
-            snprintf(prefix, sizeof prefix, "%s: solver \"%s\" (%s)%s%s", m->base, c->solver, c->solver_origin,
+            snprintf(prefix, sizeof prefix, "%s: solver \"%s\" (%s)%s%s", m->base, c->run.solver, c->origin[run_setting_index("solver")],
                      c->n_solver_opts ? " with solver options " : "", with);
             st = wrap_error(st, prefix);
         }
         if (st || (load && !load[i])) continue;
         char sets[2048], scale[32], first[16];
         kv_text(c->set, c->n_set, 0, sets, sizeof sets);
-        matrix_format_number(c->scale, scale, sizeof scale);
-        snprintf(first, sizeof first, "%d", c->frames ? 0 : c->first_timed_frame);
-        snprintf(key, sizeof key, "%s|%s|%s|%s|%s", c->scene, scale, sets, c->asset_dir, first);
+        matrix_format_number(c->run.scale, scale, sizeof scale);
+        snprintf(first, sizeof first, "%d", c->run.frames ? 0 : c->first_timed_frame);
+        snprintf(key, sizeof key, "%s|%s|%s|%s|%s", c->run.scene, scale, sets, c->run.asset_dir ? c->run.asset_dir : "",
+                 first);
         fresh = seen_add(&scenes, key);
         if (fresh < 0) st = mpm_error(MPM_EINTERNAL, "out of memory");
         if (fresh > 0) st = check_scene(m, c);

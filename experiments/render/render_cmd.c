@@ -11,117 +11,58 @@
 #include "core/error.h"
 #include "core/threads.h"
 #include "core/step.h"
+#include "experiments/cli/run_settings.h"
 #include "experiments/run/progress.h"
 #include "experiments/run/registry.h"
 #include "experiments/render/render.h"
 #include "experiments/run/run.h"
 #include "solvers/solver.h"
 
-#define RC_MAX_SET 64
 #define RC_DEFAULT_LONG_SIDE 800
 #define RC_MIN_SHORT_SIDE 160
 #define RC_MAX_SIDE 16384
 #define RC_FRAME_SAMPLES 40 /* per axis, collider neighbourhood sampling */
 
 typedef struct {
-    const char *scene, *solver, *out, *asset_dir;
-    int frame, width, height, threads;
-    size_t max_particles;
-    double scale;
-    char view[8];
-    int color_by;
-    SceneOverride ov[RC_MAX_SET];
-    char ov_text[RC_MAX_SET][256];
-    int n_ov;
+    RunConfig run;   /* the run settings render takes: scene, solver, scale, set, asset dir, threads, budget */
+    int frame, width, height;
+    int view;        /* index into g_views */
+    int color_by;    /* 0 material, 1 speed */
+    const char *out;
 } RenderArgs;
+
+static const char *const g_views[] = {"front", "side", "top", "iso", NULL};
+static const char *const g_colors[] = {"material", "speed", NULL};
 
 /* ------------------------------------------------------------------ arguments */
 
-static int rc_int(const char *flag, const char *s, int lo, int *out)
-{
-    char *end = NULL;
-    long v = strtol(s, &end, 10);
-    if (!s[0] || *end || v < lo || v > 1000000000L)
-        return mpm_error(MPM_EINPUT, "%s '%s': expected an integer >= %d", flag, s, lo);
-    *out = (int)v;
-    return MPM_OK;
-}
+#define R(field) offsetof(RenderArgs, field)
 
-/* An image side in pixels: [1, RC_MAX_SIDE]. */
-static int rc_side(const char *flag, const char *s, int *out)
-{
-    char *end = NULL;
-    long v = strtol(s, &end, 10);
-    if (!s[0] || *end || v < 1 || v > RC_MAX_SIDE)
-        return mpm_error(MPM_EINPUT, "%s '%s': expected an image size in pixels in [1, %d]", flag, s, RC_MAX_SIDE);
-    *out = (int)v;
-    return MPM_OK;
-}
+static const Option render_options[] = {
+    {"--frame", NULL, "N", OPT_INT, 0, 0, NULL, NULL, R(frame), 0, NULL, 0,
+     "simulate N frames with the solver first (default 0: the initial state)"},
+    {"--out", NULL, "FILE.png", OPT_TEXT, 0, 0, "a file name", NULL, R(out), 0, NULL, 0,
+     "the picture (default SCENE.png in the working directory)"},
+    {"--view", NULL, "front|side|top|iso", OPT_CHOICE, 0, 0, NULL, g_views, R(view), 0, NULL, 0,
+     "direction of view (default front)"},
+    {"--color", NULL, "material|speed", OPT_CHOICE, 0, 0, NULL, g_colors, R(color_by), 0, NULL, 0,
+     "colour the particles by material (default) or by speed"},
+    {"--width", NULL, "W", OPT_INT, 1, RC_MAX_SIDE, "an image size in pixels", NULL, R(width), 0, NULL, 0,
+     "image width (default: from the height and the framed box's aspect, else 800 on the longer side)"},
+    {"--height", NULL, "H", OPT_INT, 1, RC_MAX_SIDE, "an image size in pixels", NULL, R(height), 0, NULL, 0,
+     "image height (with both, the box is fitted into W x H)"},
+    {NULL}};
 
-static int rc_double(const char *flag, const char *s, double *out)
-{
-    char *end = NULL;
-    double v = strtod(s, &end);
-    if (!s[0] || *end || !isfinite(v) || !(v > 0))
-        return mpm_error(MPM_EINPUT, "%s '%s': expected a positive number", flag, s);
-    *out = v;
-    return MPM_OK;
-}
+/* the run settings of the simulated frames */
+static const char *const render_settings[] = {"--scene",     "--solver",  "--scale",         "--set",
+                                              "--asset-dir", "--threads", "--max-particles", NULL};
+static const char *const render_required[] = {"--scene", NULL};
 
-static int parse_render_args(int argc, char **argv, RenderArgs *a)
+static void render_init(void *args)
 {
-    memset(a, 0, sizeof *a);
-    a->solver = "pn-pcg";
-    a->scale = 1.0;
-    strcpy(a->view, "front");
-    int st;
-    for (int i = 2; i < argc; ++i) {
-        const char *f = argv[i];
-        if (strncmp(f, "--", 2)) return mpm_error(MPM_EINPUT, "render: unexpected argument '%s'", f);
-        if (i + 1 >= argc) {
-            if (!strcmp(f, "--scene") || !strcmp(f, "--frame") || !strcmp(f, "--out") || !strcmp(f, "--solver") ||
-                !strcmp(f, "--scale") || !strcmp(f, "--set") || !strcmp(f, "--view") || !strcmp(f, "--color") ||
-                !strcmp(f, "--width") || !strcmp(f, "--height") || !strcmp(f, "--asset-dir") ||
-                !strcmp(f, "--threads") || !strcmp(f, "--max-particles"))
-                return mpm_error(MPM_EINPUT, "%s: missing value", f);
-            return mpm_error(MPM_EINPUT, "render: unknown option '%s' (see: mpmbench --help)", f);
-        }
-        const char *v = argv[++i];
-        if (!strcmp(f, "--scene")) a->scene = v;
-        else if (!strcmp(f, "--solver")) a->solver = v;
-        else if (!strcmp(f, "--out")) a->out = v;
-        else if (!strcmp(f, "--asset-dir")) a->asset_dir = v;
-        else if (!strcmp(f, "--frame")) { if ((st = rc_int(f, v, 0, &a->frame))) return st; }
-        else if (!strcmp(f, "--width")) { if ((st = rc_side(f, v, &a->width))) return st; }
-        else if (!strcmp(f, "--height")) { if ((st = rc_side(f, v, &a->height))) return st; }
-        else if (!strcmp(f, "--threads")) { if ((st = threads_parse(f, v, &a->threads))) return st; }
-        else if (!strcmp(f, "--max-particles")) { if ((st = scene_parse_particle_budget(f, v, &a->max_particles))) return st; }
-        else if (!strcmp(f, "--scale")) { if ((st = rc_double(f, v, &a->scale))) return st; }
-        else if (!strcmp(f, "--view")) {
-            if (strcmp(v, "front") && strcmp(v, "side") && strcmp(v, "top") && strcmp(v, "iso"))
-                return mpm_error(MPM_EINPUT, "--view '%s': expected front, side, top or iso", v);
-            strcpy(a->view, v);
-        } else if (!strcmp(f, "--color")) {
-            if (!strcmp(v, "material")) a->color_by = 0;
-            else if (!strcmp(v, "speed")) a->color_by = 1;
-            else return mpm_error(MPM_EINPUT, "--color '%s': expected material or speed", v);
-        } else if (!strcmp(f, "--set")) {
-            if (a->n_ov >= RC_MAX_SET) return mpm_error(MPM_EINPUT, "too many --set options");
-            const char *eq = strchr(v, '=');
-            if (!eq || eq == v) return mpm_error(MPM_EINPUT, "--set '%s': expected key=value", v);
-            if (strlen(v) + 1 > sizeof a->ov_text[0]) return mpm_error(MPM_EINPUT, "--set '%s': too long", v);
-            char *s = a->ov_text[a->n_ov];
-            strcpy(s, v);
-            s[eq - v] = '\0';
-            a->ov[a->n_ov].key = s;
-            a->ov[a->n_ov].value = s + (eq - v) + 1;
-            a->n_ov++;
-        } else
-            return mpm_error(MPM_EINPUT, "render: unknown option '%s' (see: mpmbench --help)", f);
-    }
-    if (!a->scene) return mpm_error(MPM_EINPUT, "render: --scene is required");
-    if (a->out && !a->out[0]) return mpm_error(MPM_EINPUT, "--out: empty file name");
-    return MPM_OK;
+    RenderArgs *a = args;
+    run_config_default(&a->run);
+    a->run.solver = "pn-pcg";
 }
 
 /* ------------------------------------------------------------------ colliders */
@@ -264,7 +205,7 @@ static void view_axes(const char *view, double right[3], double up[3])
 static void image_size(const RenderArgs *a, const double lo[3], const double hi[3], int *W, int *H)
 {
     double right[3], up[3];
-    view_axes(a->view, right, up);
+    view_axes(g_views[a->view], right, up);
     double umin = INFINITY, umax = -INFINITY, vmin = INFINITY, vmax = -INFINITY;
     for (int k = 0; k < 8; ++k) {
         double c[3] = {k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]};
@@ -391,7 +332,7 @@ static int render_state(const RenderArgs *a, const Scene *sc, const Particles *p
     RenderOptions ro;
     memset(&ro, 0, sizeof ro);
     image_size(a, lo, hi, &ro.width, &ro.height);
-    memcpy(ro.view, a->view, sizeof ro.view);
+    snprintf(ro.view, sizeof ro.view, "%s", g_views[a->view]);
     ro.color_by = a->color_by;
     memcpy(ro.lo, lo, sizeof lo);
     memcpy(ro.hi, hi, sizeof hi);
@@ -409,35 +350,33 @@ static int render_state(const RenderArgs *a, const Scene *sc, const Particles *p
     }
     SdfCtx ctx = {sc, t, idx};
     status = render_png(path, n, p->x, p->mat, sc->n_materials, n_draw, sdf_cb, &ctx, &ro);
-    if (!status) printf("wrote %s (%dx%d, %s view, t = %.4g s, %d particles)\n", path, ro.width, ro.height, a->view, t, n);
+    if (!status) printf("wrote %s (%dx%d, %s view, t = %.4g s, %d particles)\n", path, ro.width, ro.height, g_views[a->view], t, n);
 done:
     free(speed);
     free(idx);
     return status;
 }
 
-int render_command(int argc, char **argv)
+static int render_run(void *args, const char *operand, int *exit_code)
 {
-    static RenderArgs a;
-    int status = parse_render_args(argc, argv, &a);
-    if (status) return status;
+    (void)operand, (void)exit_code;
+    const RenderArgs *a = args;
     Solver *solver = NULL;
-    if ((status = solver_from_spec(a.solver, NULL, 0, &solver))) return status;
-    if (a.threads > 0) omp_set_num_threads(a.threads);
+    int status;
+    if ((status = solver_from_spec(a->run.solver, NULL, 0, &solver))) return status;
+    if (a->run.threads > 0) omp_set_num_threads(a->run.threads);
 
     Scene scene;
-    SceneLoadOptions lo = {.scale = a.scale, .overrides = a.ov, .n_overrides = a.n_ov, .asset_dir = a.asset_dir,
-                           .max_particles = a.max_particles};
-    if ((status = scene_load(a.scene, &lo, &scene))) {
+    if ((status = run_scene_load(&a->run, &scene))) {
         solver_destroy(solver);
         return status;
     }
     char path[1100];
-    if (a.out) snprintf(path, sizeof path, "%s", a.out);
+    if (a->out) snprintf(path, sizeof path, "%s", a->out);
     else snprintf(path, sizeof path, "%s.png", scene.name);
 
-    if (a.frame == 0) {
-        status = render_state(&a, &scene, &scene.particles, 0.0, path);
+    if (a->frame == 0) {
+        status = render_state(a, &scene, &scene.particles, 0.0, path);
         solver_destroy(solver);
         scene_free(&scene);
         return status;
@@ -447,14 +386,27 @@ int render_command(int argc, char **argv)
     memset(&sim, 0, sizeof sim);
     int worst = SOLVE_CONVERGED;
     if ((status = sim_init(&sim, &scene))) goto done;
-    if ((status = simulate(&sim, solver, a.frame, &worst))) goto done;
+    if ((status = simulate(&sim, solver, a->frame, &worst))) goto done;
     if (worst != SOLVE_CONVERGED)
         fprintf(stderr, "mpmbench: warning: some steps did not converge (worst status %s)\n",
                 solve_status_name((SolveStatus)worst));
-    status = render_state(&a, &scene, &sim.p, sim.t, path);
+    status = render_state(a, &scene, &sim.p, sim.t, path);
 done:
     sim_free(&sim);
     solver_destroy(solver);
     scene_free(&scene);
     return status;
 }
+
+const Command render_command = {
+    .name = "render",
+    .required = render_required,
+    .summary = "A PNG picture of a scene: its initial state, or its state after simulating --frame N frames with "
+               "--solver (default pn-pcg).",
+    .notes = "Particles are coloured by material or speed; colliders are drawn, the domain walls and vertical\n"
+             "half-spaces are not. The framed box is the particles' box with the colliders near it, plus a margin.\n",
+    .groups = {{render_options, 0, NULL, 0, NULL}, {run_settings, 0, render_settings, R(run), "run settings"}},
+    .n_groups = 2,
+    .args_size = sizeof(RenderArgs),
+    .init = render_init,
+    .run = render_run};

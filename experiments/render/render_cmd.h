@@ -1,10 +1,7 @@
 /* `mpmbench render`: a PNG picture of a scene, either its initial state
  * (frame 0, no simulation) or after simulating N frames with a solver.
  *
- *   mpmbench render --scene NAME|FILE [--frame N] [--out FILE.png]
- *                   [--solver NAME] [--scale S] [--set key=value ...]
- *                   [--view front|side|top|iso] [--color material|speed]
- *                   [--width W] [--height H] [--asset-dir DIR] [--threads T]
+ *   mpmbench render --scene NAME|FILE [options]   (mpmbench render --help)
  *
  * Defaults: frame 0, solver pn-pcg, view front, colour by material, output
  * <scene name>.png in the working directory. With neither --width nor
@@ -35,7 +32,9 @@
 #ifndef MPM_RENDER_CMD_H
 #define MPM_RENDER_CMD_H
 
-/* argv[1] is "render"; options start at argv[2]. */
-int render_command(int argc, char **argv);
+#include "experiments/cli/cli.h"
+
+/* The command (options and help: render_cmd.c). */
+extern const Command render_command;
 
 #endif

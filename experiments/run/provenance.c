@@ -26,6 +26,14 @@
 #ifndef MPM_SOURCE_DIR
 #define MPM_SOURCE_DIR "."
 #endif
+#ifndef MPM_VERSION
+#define MPM_VERSION "unknown"
+#endif
+
+void provenance_version(char *out, size_t n)
+{
+    snprintf(out, n, "mpmbench %s (git %s%s)", MPM_VERSION, MPM_GIT_COMMIT, MPM_GIT_DIRTY > 0 ? ", modified" : "");
+}
 
 /* CPU model and physical core count from /proc/cpuinfo (Linux). */
 static void cpu_info(char *model, size_t n, int *physical)
@@ -120,7 +128,8 @@ json_t *provenance_json(int threads, int with_checkout)
     if (uname(&un) == 0) snprintf(os, sizeof os, "%s %s %s", un.sysname, un.release, un.machine);
     char jansson[32];
     snprintf(jansson, sizeof jansson, "%s", JANSSON_VERSION);
-    json_t *build = json_pack("{s:s, s:o, s:s, s:s, s:s}", "git_commit", MPM_GIT_COMMIT, "git_dirty",
+    json_t *build = json_pack("{s:s, s:s, s:o, s:s, s:s, s:s}", "version", MPM_VERSION, "git_commit", MPM_GIT_COMMIT,
+                              "git_dirty",
                               MPM_GIT_DIRTY < 0 ? json_null() : json_boolean(MPM_GIT_DIRTY > 0),
                               "compiler", MPM_COMPILER, "flags", MPM_BUILD_FLAGS, "build_type",
                               MPM_BUILD_TYPE);

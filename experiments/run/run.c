@@ -29,6 +29,33 @@ void run_config_default(RunConfig *c)
     c->scale = 1.0;
 }
 
+/* The --set texts as scene_load's path/value pairs (checked: key=value,
+ * shorter than RUN_SET_TEXT). */
+static int split_overrides(const RunConfig *cfg, SceneOverride *ov, char (*text)[RUN_SET_TEXT])
+{
+    for (int i = 0; i < cfg->n_set; ++i) {
+        const char *eq = strchr(cfg->set[i], '=');
+        if (!eq || eq == cfg->set[i] || strlen(cfg->set[i]) >= RUN_SET_TEXT)
+            return mpm_error(MPM_EINPUT, "--set '%s': expected key=value", cfg->set[i]);
+        snprintf(text[i], RUN_SET_TEXT, "%s", cfg->set[i]);
+        text[i][eq - cfg->set[i]] = '\0';
+        ov[i].key = text[i];
+        ov[i].value = text[i] + (eq - cfg->set[i]) + 1;
+    }
+    return MPM_OK;
+}
+
+int run_scene_load(const RunConfig *cfg, Scene *scene)
+{
+    SceneOverride ov[RUN_MAX_LIST];
+    char text[RUN_MAX_LIST][RUN_SET_TEXT];
+    int st = split_overrides(cfg, ov, text);
+    if (st) return st;
+    SceneLoadOptions lo = {.scale = cfg->scale, .overrides = ov, .n_overrides = cfg->n_set,
+                           .asset_dir = cfg->asset_dir, .max_particles = cfg->max_particles};
+    return scene_load(cfg->scene, &lo, scene);
+}
+
 void run_solve_settings(const RunConfig *cfg, SolveSettings *set)
 {
     solve_settings_default(set);
@@ -128,8 +155,12 @@ static void write_run_json(const char *dir, const RunConfig *cfg, const Scene *s
     json_t *opts = json_object(), *ovr = json_object();
     /* every option the solver consulted, with the value in effect (given or default) */
     for (int i = 0; i < so->n_asked; ++i) json_object_set_new(opts, so->asked[i], json_string(so->asked_value[i]));
-    for (int i = 0; i < cfg->n_overrides; ++i)
-        json_object_set_new(ovr, cfg->overrides[i].key, json_string(cfg->overrides[i].value));
+    for (int i = 0; i < cfg->n_set; ++i) {
+        const char *eq = strchr(cfg->set[i], '='); /* checked when the scene was loaded */
+        char key[RUN_SET_TEXT];
+        snprintf(key, sizeof key, "%.*s", eq ? (int)(eq - cfg->set[i]) : 0, cfg->set[i]);
+        json_object_set_new(ovr, key, json_string(eq ? eq + 1 : ""));
+    }
     json_t *limits = json_pack("{s:i, s:i, s:f, s:f, s:s}", "max_outer", set->max_outer, "max_linear", set->max_linear,
                                "max_step_seconds", cfg->max_step_s, "max_run_seconds", cfg->max_run_s, "on_failure",
                                cfg->on_failure == RUN_CONTINUE ? "continue" : "stop");
@@ -253,9 +284,7 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     }
 
     Scene scene;
-    SceneLoadOptions lo = {.scale = cfg->scale, .overrides = cfg->overrides, .n_overrides = cfg->n_overrides,
-                           .asset_dir = cfg->asset_dir, .max_particles = cfg->max_particles};
-    if ((status = scene_load(cfg->scene, &lo, &scene))) {
+    if ((status = run_scene_load(cfg, &scene))) {
         run_accuracy_free(&acc);
         solver_destroy(solver);
         return status;

@@ -16,6 +16,13 @@ typedef enum {
                          failed): then stop as RUN_STOP */
 } FailurePolicy;
 
+#define RUN_MAX_LIST 64          /* --set and --solver-opt values */
+#define RUN_SET_TEXT 256         /* characters of one --set key=value, with its NUL */
+
+/* The settings of a run. Every field but the lists is set by one line of the
+ * run settings table (experiments/cli/run_settings.c), which parses the
+ * flags, reads the matrix-file keys and writes a cell's command line; a new
+ * setting is a field here and a line there. */
 typedef struct {
     const char *scene;          /* built-in name or JSON path */
     const char *solver;         /* solver spec: preset name or OUTER:INVERSE[:k=v,...] */
@@ -24,9 +31,9 @@ typedef struct {
     double scale;               /* dx multiplier */
     int threads;                /* <= 0: OpenMP default */
     const char *out_dir;        /* NULL: out/<scene>-<solver> */
-    const SceneOverride *overrides;
-    int n_overrides;
-    const char *const *solver_opts;
+    const char *set[RUN_MAX_LIST]; /* --set PATH=VALUE texts, in order (a later one wins) */
+    int n_set;
+    const char *solver_opts[RUN_MAX_LIST]; /* --solver-opt KEY=VALUE texts */
     int n_solver_opts;
     int history;                /* write iters.csv */
     const char *particles_dir;  /* PLY per frame when set */
@@ -88,6 +95,9 @@ int run_step(Simulation *sim, Solver *solver, const SolveSettings *set, StepWork
              int apply_failed, SolveStats *ss, StepInfo *info);
 
 void run_config_default(RunConfig *c);
+/* Loads cfg's scene with its scale, --set overrides, asset directory and
+ * particle budget (scene_load). */
+int run_scene_load(const RunConfig *cfg, Scene *scene);
 /* Validates every setting of cfg without doing any work (no scene sampled,
  * no folder made): flags, limits, paths, the solver spec with its options
  * (solver_spec_check). MPM_EINPUT with one line naming the flag and value. */

@@ -76,10 +76,10 @@ expect_input_error "max_iters=0: expected an integer" run --scene drop --solver 
 expect_input_error "levels=nan: expected a number" run --scene drop --solver hot --solver-opt levels=nan
 # the solver is validated before the scene is even looked up
 expect_input_error "window=2.5" run --scene nosuchscene --solver hot --solver-opt window=2.5
-expect_input_error "--max-outer 0: expected an integer >= 1" run --scene drop --solver pn-pcg --max-outer 0
+expect_input_error "--max-outer '0': expected an integer >= 1" run --scene drop --solver pn-pcg --max-outer 0
 expect_input_error "--max-linear 'x': expected an integer" run --scene drop --solver pn-pcg --max-linear x
-expect_input_error "--max-step-seconds -1: expected seconds" run --scene drop --solver pn-pcg --max-step-seconds -1
-expect_input_error "--max-run-seconds nan" run --scene drop --solver pn-pcg --max-run-seconds nan
+expect_input_error "--max-step-seconds '-1': expected seconds in \\(0, 1e9\\]" run --scene drop --solver pn-pcg --max-step-seconds -1
+expect_input_error "--max-run-seconds 'nan'" run --scene drop --solver pn-pcg --max-run-seconds nan
 expect_input_error "--on-failure 'maybe'" run --scene drop --solver pn-pcg --on-failure maybe
 expect_input_error "--out '': expected a directory" run --scene drop --solver pn-pcg --out ""
 touch "$tmp/afile"

@@ -1,14 +1,22 @@
 # Shared by the tests/test_*.sh CLI tests (sourced, not a test itself):
 # `bin` and `src` from the arguments CTest passes, a scratch directory `tmp`
-# removed at exit, and the checks below counting into `checks` / `fails`;
+# removed at exit (kept with KEEP_TMP=1, to look into a failure), and the checks below counting into `checks` / `fails`;
 # a test ends with `finish`.
 set -u
 bin="$1"
 src="$2"
 tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+trap '[ -n "${KEEP_TMP:-}" ] || rm -rf "$tmp"' EXIT
 fails=0
 checks=0
+
+# `matrix report` runs MPM_PYTHON, else the python3 on PATH. When that one has
+# no matplotlib (a pyenv or virtual-environment python3 first on PATH) and
+# Debian's /usr/bin/python3 has it, the report tests use Debian's.
+if [ -z "${MPM_PYTHON:-}" ] && ! python3 -c 'import matplotlib' 2>/dev/null &&
+  /usr/bin/python3 -c 'import matplotlib' 2>/dev/null; then
+  export MPM_PYTHON=/usr/bin/python3
+fi
 
 check() { # description, condition-command...
   local what="$1"; shift

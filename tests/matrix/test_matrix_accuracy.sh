@@ -86,7 +86,7 @@ cat >"$tmp/bad.json" <<'EOF'
  "cell_timeout_s": 1}
 EOF
 "$bin" matrix run "$tmp/bad.json" --out "$tmp/b" --check >"$tmp/bad.txt" 2>"$tmp/bad.err"
-check "failed reference: --check exits 1" test $? -eq 1
+check "failed reference: --check exits 3" test $? -eq 3
 check "failed reference: the reference timed out" test "$(col "$tmp/b/cells.csv" status role reference)" = timeout
 check "failed reference: dependents skipped, no rows" test "$(grep -c '^\[skipped\]' "$tmp/bad.txt")" -eq 2 -a \
   "$(($(wc -l <"$tmp/b/cells.csv") - 1))" -eq 1

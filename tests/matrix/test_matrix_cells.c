@@ -51,7 +51,7 @@ static int load_text(const char *text, Matrix *m, MatrixCells *c)
 static const MatrixCell *find(const MatrixCells *c, const char *scene, const char *solver, double eps)
 {
     for (int i = 0; i < c->n; ++i)
-        if (!strcmp(c->cells[i].scene, scene) && !strcmp(c->cells[i].solver, solver) && c->cells[i].eps == eps)
+        if (!strcmp(c->cells[i].run.scene, scene) && !strcmp(c->cells[i].run.solver, solver) && c->cells[i].run.eps == eps)
             return &c->cells[i];
     return NULL;
 }
@@ -149,9 +149,9 @@ static void test_ids(void)
           "matrix b");
     CHECK(ca.n == 2 && cb.n == 6, "%d and %d cells", ca.n, cb.n);
     for (int i = 0; i < ca.n; ++i) {
-        const MatrixCell *x = &ca.cells[i], *y = find(&cb, x->scene, x->solver, x->eps);
-        CHECK(y && !strcmp(x->id, y->id) && !strcmp(x->canonical, y->canonical), "%s/%s keeps id %s", x->scene,
-              x->solver, x->id);
+        const MatrixCell *x = &ca.cells[i], *y = find(&cb, x->run.scene, x->run.solver, x->run.eps);
+        CHECK(y && !strcmp(x->id, y->id) && !strcmp(x->canonical, y->canonical), "%s/%s keeps id %s", x->run.scene,
+              x->run.solver, x->id);
     }
     const MatrixCell *hot = find(&ca, "drop", "hot", 1e-7);
     CHECK(hot != NULL, "drop/hot");

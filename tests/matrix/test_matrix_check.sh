@@ -6,7 +6,7 @@
 # energy increase, a NaN in frames.csv, a cell killed at the wall-clock limit,
 # a crash, an internal error, a reported particle escape (passes), a run
 # that stopped early without a reason, and an unknown status. --check exits
-# 1 with one line, prints each failing cell, writes check.csv, and the
+# 3 with one line, prints each failing cell, writes check.csv, and the
 # report shows the grid.
 . "$(dirname "$0")/../common/shell_harness.sh"
 
@@ -69,7 +69,7 @@ edit "$d/$id_short/frames.csv" --cut 0 x
 edit "$d/$id_status/steps.csv" status 0 exploded
 
 "$bin" matrix run "$tmp/m.json" --out "$tmp/r" --check >"$tmp/out.txt" 2>"$tmp/err.txt"
-check "altered: exit 1" test $? -eq 1
+check "altered: exit 3 (cells failed their check)" test $? -eq 3
 check "altered: one error line naming the count" test "$(wc -l <"$tmp/err.txt")" -eq 1 -a \
   "$(grep -c 'matrix run --check: 8 of 10 cells failed' "$tmp/err.txt")" -eq 1
 check "altered: nothing rerun" grep -q "10 done already, 0 to run" "$tmp/out.txt"

@@ -31,7 +31,7 @@ bad empty-set-axis 'empty-set-axis\.json: axes\.sets\.stiff: empty list' \
   '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hot"], "sets": {"stiff": []}}}'
 bad eps-type 'eps-type\.json: axes\.eps\[1\]: expected a positive number, got "tight"' \
   "{$head, \"axes\": {\"scene\": [\"drop\"], \"solver\": [\"hot\"], \"eps\": [1e-7, \"tight\"]}}"
-bad threads-zero 'threads-zero\.json: defaults\.threads: expected an integer >= 1, got 0' \
+bad threads-zero 'threads-zero\.json: defaults\.threads: expected an integer number of threads in \[1, 1024\], got 0' \
   '{"name": "t", "defaults": {"threads": 0}, "axes": {"scene": ["drop"], "solver": ["hot"]}}'
 bad frames-real 'frames-real\.json: scenes\.drop\.frames: expected an integer >= 1, got 2\.5' \
   '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hot"]}, "scenes": {"drop": {"frames": 2.5}}}'
@@ -83,7 +83,7 @@ bad error-ref-eps 'error-ref-eps\.json: axes\.error_ref\[1\]: --error-ref auto:-
   '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hot"], "error_ref": ["auto", "auto:-1"]}}'
 bad max-outer 'max-outer\.json: defaults\.max_outer: expected an integer >= 1, got 0' \
   '{"name": "t", "defaults": {"max_outer": 0}, "axes": {"scene": ["drop"], "solver": ["hot"]}}'
-bad max-step 'max-step\.json: scenes\.drop\.max_step_seconds: expected a positive number, got -1' \
+bad max-step 'max-step\.json: scenes\.drop\.max_step_seconds: expected seconds in \(0, 1e9\], got -1' \
   '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hot"]}, "scenes": {"drop": {"max_step_seconds": -1}}}'
 bad on-failure 'on-failure\.json: defaults\.on_failure: expected "stop" or "continue", got "retry"' \
   '{"name": "t", "defaults": {"on_failure": "retry"}, "axes": {"scene": ["drop"], "solver": ["hot"]}}'

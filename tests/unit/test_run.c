@@ -146,8 +146,7 @@ static void config_check(void)
     CHECK(run_config_check(&c) == MPM_EINPUT && strstr(mpm_last_error(), "--eps"), "eps below the floor refused: %s",
           mpm_last_error());
     c.eps = 1e-7;
-    const char *opt[] = {"window=2.5"};
-    c.solver_opts = opt;
+    c.solver_opts[0] = "window=2.5";
     c.n_solver_opts = 1;
     mpm_clear_error();
     CHECK(run_config_check(&c) == MPM_EINPUT && strstr(mpm_last_error(), "window=2.5"), "window=2.5: %s",

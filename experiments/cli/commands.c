@@ -1,0 +1,223 @@
+/* The commands of mpmbench (commands.h): list, run and bench here; render
+ * and the matrix commands beside their code. */
+#include "experiments/cli/commands.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "core/scene.h"
+#include "core/threads.h"
+#include "experiments/bench/bench.h"
+#include "experiments/cli/run_settings.h"
+#include "experiments/matrix/matrix_cmd.h"
+#include "experiments/render/render_cmd.h"
+#include "experiments/run/provenance.h"
+#include "experiments/run/registry.h"
+#include "experiments/run/run.h"
+
+/* ------------------------------------------------------------------ list */
+
+static const char *const list_what[] = {"solvers", "scenes", NULL};
+
+static void print_scene(const char *name, const char *desc, void *ctx)
+{
+    (void)ctx;
+    printf("%-16s %s\n", name, desc);
+}
+
+static int list_run(void *args, const char *what, int *exit_code)
+{
+    (void)args, (void)exit_code;
+    if (!strcmp(what, "solvers")) {
+        registry_print(stdout);
+        return MPM_OK;
+    }
+    return scene_list(print_scene, NULL);
+}
+
+static const Command list_command = {
+    .name = "list",
+    .operand = "solvers|scenes",
+    .operand_choices = list_what,
+    .operand_missing = "'solvers' or 'scenes'",
+    .summary = "The registered solvers (presets, outer methods, inverse approximations and their options, "
+               "strategies) or the built-in scenes.",
+    .run = list_run};
+
+/* ------------------------------------------------------------------ run */
+
+static void run_init(void *args) { run_config_default(args); }
+
+static int run_run(void *args, const char *operand, int *exit_code)
+{
+    (void)operand, (void)exit_code;
+    RunSummary sum;
+    return run_simulation(args, &sum);
+}
+
+static const char *const run_required[] = {"--scene", "--solver", NULL};
+
+static const Command run_command = {
+    .name = "run",
+    .required = run_required,
+    .summary = "Simulates a scene with a solver: steps.csv (one row per time step), frames.csv (one per frame), "
+               "run.json (the settings in effect and the provenance), inverse_stats.csv, and iters.csv with "
+               "--history, in --out.",
+    .notes = "Every setting is checked before the scene is sampled or the folder made. A step that does not\n"
+             "converge is not an error: its status (converged, capped, stalled, timeout, failed) is in the CSV.\n"
+             "In a matrix file (mpmbench matrix run) a setting is given by its key.\n",
+    .groups = {{run_settings, 0, NULL, 0, "run settings", 1}},
+    .n_groups = 1,
+    .args_size = sizeof(RunConfig),
+    .init = run_init,
+    .run = run_run};
+
+/* ------------------------------------------------------------------ bench */
+
+static const char *const bench_what[] = {"spmv", "assemble", "p2g", "all", NULL};
+/* the run settings the kernels use: the scene as `run` loads it, and the threads */
+static const char *const bench_settings[] = {"--scene", "--scale", "--threads", "--set", "--asset-dir",
+                                             "--max-particles", NULL};
+static const char *const bench_required[] = {"--scene", NULL};
+
+static int bench_cmd(void *args, const char *what, int *exit_code)
+{
+    (void)exit_code;
+    return bench_run(what, args);
+}
+
+static const Command bench_command = {
+    .name = "bench",
+    .operand = "spmv|assemble|p2g|all",
+    .operand_choices = bench_what,
+    .operand_missing = "spmv, assemble, p2g or all",
+    .required = bench_required,
+    .summary = "Kernel throughput on a scene's first time step: block-CSR SpMV against the STREAM triad, the "
+               "matrix-free product, Hessian assembly, P2G; a table, then one key=value line per figure.",
+    .groups = {{run_settings, 0, bench_settings, 0, "run settings"}},
+    .n_groups = 1,
+    .args_size = sizeof(RunConfig),
+    .init = run_init,
+    .run = bench_cmd};
+
+/* ------------------------------------------------------------------ program */
+
+const Command *const cli_commands[] = {&list_command,       &run_command,           &bench_command, &render_command,
+                                       &matrix_run_command, &matrix_report_command, NULL};
+
+const Command *cli_command(const char *name)
+{
+    for (int i = 0; cli_commands[i]; ++i)
+        if (!strcmp(cli_commands[i]->name, name)) return cli_commands[i];
+    return NULL;
+}
+
+void cli_program_usage(FILE *f)
+{
+    fprintf(f, "usage: mpmbench COMMAND ...    (mpmbench COMMAND --help: its options)\n"
+               "       mpmbench --help | --version\n\n"
+               "Implicit MPM timesteps on benchmark scenes, every solver judged by one stopping rule.\n\n"
+               "commands:\n");
+    for (int i = 0; cli_commands[i]; ++i) {
+        fprintf(f, "  ");
+        cli_synopsis(cli_commands[i], f);
+        fprintf(f, "\n      ");
+        cli_wrap(f, 6, 6, cli_commands[i]->summary);
+    }
+    fprintf(f, "\n"
+               "Options take their value as --flag VALUE or --flag=VALUE; -h or --help after any command prints\n"
+               "its options.\n\n"
+               "exit status:\n"
+               "  0  success\n"
+               "  1  internal failure (out of memory, a library error)\n"
+               "  2  bad input: an unknown or malformed option, a bad scene or matrix file (one line on stderr\n"
+               "     naming the option or file, the field and the value)\n"
+               "  3  matrix run --check: some cell failed its check (DIR/check.csv)\n\n"
+               "environment:\n"
+               "  OMP_NUM_THREADS    threads when --threads is not given (1-1024)\n"
+               "  OMP_WAIT_POLICY    passive on a machine shared with other jobs\n"
+               "  MPM_SCENE_DIR      the folder of the built-in scenes (default: experiments/scenes)\n"
+               "  MPM_PYTHON         the Python of `matrix report` (default: python3 on PATH)\n"
+               "  MPM_SCRIPT_DIR     the folder of matrix_report.py (default: scripts/)\n");
+}
+
+static int help_wanted(const char *a) { return !strcmp(a, "--help") || !strcmp(a, "-h") || !strcmp(a, "help"); }
+
+/* The command argv names from argv[1] on ("matrix run" takes two words); *words how many. */
+static const Command *find_command(int argc, char **argv, int *words, int *status)
+{
+    *status = MPM_OK;
+    if (argc > 2) {
+        char two[128];
+        snprintf(two, sizeof two, "%s %s", argv[1], argv[2]);
+        const Command *c = cli_command(two);
+        if (c) {
+            *words = 2;
+            return c;
+        }
+    }
+    const Command *c = cli_command(argv[1]);
+    if (c) {
+        *words = 1;
+        return c;
+    }
+    /* a group of commands ("matrix"): which of its words was meant */
+    char group[64], choices[256] = "";
+    snprintf(group, sizeof group, "%s ", argv[1]);
+    size_t len = 0;
+    int n = 0;
+    for (int i = 0; cli_commands[i]; ++i)
+        if (!strncmp(cli_commands[i]->name, group, strlen(group)) && len < sizeof choices)
+            len += (size_t)snprintf(choices + len, sizeof choices - len, "%s'%s'", n++ ? " or " : "",
+                                    cli_commands[i]->name + strlen(group));
+    if (n && argc > 2 && help_wanted(argv[2])) return NULL; /* mpmbench matrix --help: the program's usage */
+    if (!n) *status = mpm_error(MPM_EINPUT, "unknown command '%s' (see: mpmbench --help)", argv[1]);
+    else if (argc < 3) *status = mpm_error(MPM_EINPUT, "%s: expected %s (see: mpmbench --help)", argv[1], choices);
+    else *status = mpm_error(MPM_EINPUT, "%s '%s': expected %s", argv[1], argv[2], choices);
+    return NULL;
+}
+
+int cli_main(int argc, char **argv)
+{
+    if (argc < 2) {
+        cli_program_usage(stderr);
+        return CLI_EXIT_INPUT;
+    }
+    if (help_wanted(argv[1]) && argc == 2) {
+        cli_program_usage(stdout);
+        return CLI_EXIT_OK;
+    }
+    if (!strcmp(argv[1], "--version")) {
+        char v[256];
+        provenance_version(v, sizeof v);
+        printf("%s\n", v);
+        return CLI_EXIT_OK;
+    }
+    int help_first = help_wanted(argv[1]); /* mpmbench help COMMAND */
+    int first = help_first ? 2 : 1, words = 0, exit_code = CLI_EXIT_OK;
+    int st = threads_check_env(); /* before OpenMP reads it at the first parallel region */
+    const Command *cmd = st ? NULL : find_command(argc - first + 1, argv + first - 1, &words, &st);
+    if (cmd && help_first) {
+        cli_usage(cmd, stdout);
+        return CLI_EXIT_OK;
+    }
+    if (cmd) {
+        void *args = cmd->args_size ? calloc(1, cmd->args_size) : NULL;
+        const char *operand;
+        int help = 0;
+        if (cmd->args_size && !args) st = mpm_error(MPM_EINTERNAL, "out of memory");
+        else st = cli_parse(cmd, argc, argv, first + words, args, &operand, &help);
+        if (!st && help) cli_usage(cmd, stdout);
+        else if (!st) st = cmd->run(args, operand, &exit_code);
+        free(args);
+    } else if (!st && argc > first + 1 && help_wanted(argv[first + 1])) {
+        cli_program_usage(stdout); /* mpmbench matrix --help */
+        return CLI_EXIT_OK;
+    }
+    if (st) {
+        fprintf(stderr, "mpmbench: error: %s\n", mpm_last_error());
+        return st == MPM_EINPUT ? CLI_EXIT_INPUT : CLI_EXIT_INTERNAL;
+    }
+    return exit_code;
+}
