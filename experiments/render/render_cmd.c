@@ -12,7 +12,7 @@
 #include "core/threads.h"
 #include "core/step.h"
 #include "experiments/cli/run_settings.h"
-#include "experiments/run/progress.h"
+#include "experiments/run/frame_driver.h"
 #include "experiments/run/registry.h"
 #include "experiments/render/render.h"
 #include "experiments/run/run.h"
@@ -240,57 +240,6 @@ static void image_size(const RenderArgs *a, const double lo[3], const double hi[
     *H = h;
 }
 
-/* ------------------------------------------------------------------ simulation */
-
-typedef struct {
-    Progress *progress;
-    int frame, step;
-    double fraction;
-} RcHook;
-
-static void rc_hook(void *ctx, int iter, double elapsed, double residual, double energy)
-{
-    (void)energy;
-    RcHook *h = ctx;
-    progress_update(h->progress, h->fraction, h->frame, h->step, iter, residual, elapsed);
-}
-
-/* Advances sim by `frames` frames with the solver; *worst gets the worst
- * SolveStatus seen. */
-static int simulate(Simulation *sim, Solver *solver, int frames, int *worst)
-{
-    int status = MPM_OK;
-    StepWork work = {.dv = NULL, .cap = 0};
-    Progress prog;
-    progress_init(&prog, frames);
-    SolveSettings set;
-    solve_settings_default(&set);
-    RcHook hook = {&prog, 0, 0, 0.0};
-    *worst = SOLVE_CONVERGED;
-    while (sim->frame < frames) {
-        int frame = sim->frame, step = 0;
-        while (sim->frame == frame) {
-            hook.frame = frame;
-            hook.step = step;
-            hook.fraction = (frame + sim->t_in_frame / sim->frame_dt) / frames;
-            SolveStats ss;
-            StepInfo si;
-            if ((status = run_step(sim, solver, &set, &work, rc_hook, &hook, 0, &ss, &si))) goto done;
-            if ((int)ss.status > *worst) *worst = ss.status;
-            if (!si.advanced) {
-                status = mpm_error(MPM_EINTERNAL, "frame %d step %d failed: %s", frame, step, ss.reason);
-                goto done;
-            }
-            ++step;
-        }
-        progress_clear(&prog);
-    }
-done:
-    progress_clear(&prog);
-    free(work.dv);
-    return status;
-}
-
 /* ------------------------------------------------------------------ command */
 
 static int render_state(const RenderArgs *a, const Scene *sc, const Particles *p, double t, const char *path)
@@ -382,14 +331,24 @@ static int render_run(void *args, const char *operand, int *exit_code)
         return status;
     }
 
+    /* the frames as `run` simulates them (no limits; a failed step ends the command) */
     Simulation sim;
     memset(&sim, 0, sizeof sim);
-    int worst = SOLVE_CONVERGED;
+    SolveSettings set;
+    solve_settings_default(&set);
+    FrameDriver driver = {.frames = a->frame};
+    RunSummary sum;
+    memset(&sum, 0, sizeof sum);
+    char why[300];
     if ((status = sim_init(&sim, &scene))) goto done;
-    if ((status = simulate(&sim, solver, a->frame, &worst))) goto done;
-    if (worst != SOLVE_CONVERGED)
+    if ((status = frame_driver_run(&driver, &sim, solver, &set, &sum, why, sizeof why))) goto done;
+    if (sum.stopped) {
+        status = mpm_error(MPM_EINTERNAL, "%s", why);
+        goto done;
+    }
+    if (sum.worst_status != SOLVE_CONVERGED)
         fprintf(stderr, "mpmbench: warning: some steps did not converge (worst status %s)\n",
-                solve_status_name((SolveStatus)worst));
+                solve_status_name((SolveStatus)sum.worst_status));
     status = render_state(a, &scene, &sim.p, sim.t, path);
 done:
     sim_free(&sim);

@@ -11,10 +11,10 @@
 
 #include "core/error.h"
 #include "core/step.h"
+#include "experiments/run/frame_driver.h"
 #include "experiments/run/library_startup.h"
 #include "experiments/run/paths.h"
 #include "experiments/run/ply.h"
-#include "experiments/run/progress.h"
 #include "experiments/run/provenance.h"
 #include "experiments/run/registry.h"
 #include "experiments/accuracy/run_accuracy.h"
@@ -130,19 +130,71 @@ static void csv_text(FILE *f, const char *s)
     fputc('"', f);
 }
 
+/* What `run` writes as the frame driver goes: the CSV rows, the table, the
+ * particles. */
 typedef struct {
-    FILE *iters;
-    Progress *progress;
-    int frame, step;
-    double fraction;
-} HookCtx;
+    const RunConfig *cfg;
+    const Scene *scene;
+    const Solver *solver;
+    RunAccuracy *acc;
+    FILE *steps_csv, *frames_csv, *iters_csv;
+    int threads;
+} RunOutput;
 
-static void iter_hook(void *ctx, int iter, double elapsed, double residual, double energy)
+static void write_iteration(void *ctx, int frame, int step, int iter, double elapsed, double residual, double energy)
 {
-    HookCtx *h = ctx;
-    if (h->iters)
-        fprintf(h->iters, "%d,%d,%d,%.6e,%.9e,%.12e\n", h->frame, h->step, iter, elapsed, residual, energy);
-    progress_update(h->progress, h->fraction, h->frame, h->step, iter, residual, elapsed);
+    RunOutput *o = ctx;
+    if (o->iters_csv)
+        fprintf(o->iters_csv, "%d,%d,%d,%.6e,%.9e,%.12e\n", frame, step, iter, elapsed, residual, energy);
+}
+
+static int before_step(void *ctx, Simulation *sim, int frame, int step, StepWork *w)
+{
+    (void)frame;
+    RunOutput *o = ctx;
+    return run_accuracy_before_step(o->acc, sim, step, w);
+}
+
+static int write_step(void *ctx, const Simulation *sim, int frame, int step, const SolveStats *ss, const StepInfo *si)
+{
+    RunOutput *o = ctx;
+    FILE *f = o->steps_csv;
+    /* t and dt read back as the same doubles (--dt-from replays them) */
+    fprintf(f, "%s,%s,%d,%d,%.17g,%.17g,%zu,%d,%lld,%d,%ld,%d,%.6e,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%ld,",
+            o->scene->name, o->solver->name, frame, step, si->t, si->dt, sim->p.n, si->active_nodes,
+            (long long)ss->hessian_blocks, ss->outer_iters, ss->linear_iters, ss->ls_evals, ss->residual,
+            solve_status_name(ss->status), si->wall_s, si->begin_s, ss->assemble_s, ss->setup_s, ss->solve_s,
+            ss->linesearch_s, si->end_s, o->threads, ss->inner_iters);
+    fprintf(f, "%.9g,", ss->energy_increase_max);
+    run_accuracy_step_fields(f, o->acc);
+    csv_text(f, ss->reason); /* the reason stays the last field */
+    fputc('\n', f);
+    return MPM_OK;
+}
+
+static int write_frame(void *ctx, const Simulation *sim, const FrameSums *fs, int stopping)
+{
+    RunOutput *o = ctx;
+    FILE *f = o->frames_csv;
+    fprintf(f, "%s,%s,%d,%d,%ld,%ld,%.6f,%.6e,%s,%d,%ld,", o->scene->name, o->solver->name, fs->frame, fs->steps,
+            fs->outer_iters, fs->linear_iters, fs->wall_s, fs->max_residual, solve_status_name((SolveStatus)fs->status),
+            o->threads, fs->inner_iters);
+    int status = run_accuracy_frame_end(o->acc, sim, fs->frame, fs->steps, fs->completed, f);
+    csv_text(f, fs->reason);
+    fputc('\n', f);
+    if (status) return status;
+    fflush(o->steps_csv);
+    fflush(f);
+    if (!o->cfg->quiet)
+        printf("%6d %6d %8ld %9ld %9ld %10.3f %12.3e  %s\n", fs->frame, fs->steps, fs->outer_iters, fs->linear_iters,
+               fs->inner_iters, fs->wall_s, fs->max_residual, solve_status_name((SolveStatus)fs->status));
+    fflush(stdout);
+    if (o->cfg->particles_dir && !stopping) {
+        char path[1200];
+        snprintf(path, sizeof path, "%s/frame_%04d.ply", o->cfg->particles_dir, fs->frame + 1);
+        return ply_write_particles(path, &sim->p);
+    }
+    return MPM_OK;
 }
 
 /* Records the exact configuration beside the tables, so every number says
@@ -240,25 +292,6 @@ int run_step(Simulation *sim, Solver *solver, const SolveSettings *set, StepWork
     return MPM_OK;
 }
 
-static int worse(int a, int b) { return a > b ? a : b; } /* SolveStatus is ordered by severity */
-
-/* The deadline of the next solve: the earlier of the step's and the run's. */
-static void set_deadline(const RunConfig *cfg, double run_t0, SolveSettings *set, char *why, size_t len)
-{
-    double now = omp_get_wtime();
-    set->deadline = 0.0;
-    set->deadline_reason = why;
-    why[0] = '\0';
-    if (cfg->max_step_s > 0) {
-        set->deadline = now + cfg->max_step_s;
-        snprintf(why, len, "--max-step-seconds %g", cfg->max_step_s);
-    }
-    if (cfg->max_run_s > 0 && (set->deadline == 0.0 || run_t0 + cfg->max_run_s < set->deadline)) {
-        set->deadline = run_t0 + cfg->max_run_s;
-        snprintf(why, len, "--max-run-seconds %g", cfg->max_run_s);
-    }
-}
-
 int run_simulation(const RunConfig *cfg, RunSummary *sum)
 {
     int status = MPM_OK;
@@ -304,7 +337,6 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     Simulation sim;
     memset(&sim, 0, sizeof sim);
     FILE *steps_csv = NULL, *frames_csv = NULL, *iters_csv = NULL;
-    StepWork work = {.dv = NULL, .cap = 0};
     if ((status = paths_mkdir_p(out_dir))) goto done;
     if (cfg->particles_dir && (status = paths_mkdir_p(cfg->particles_dir))) goto done;
     if (!(steps_csv = open_in(out_dir, "steps.csv", &status))) goto done;
@@ -325,8 +357,6 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     if ((status = sim_init(&sim, &scene))) goto done;
     sum->particles = scene.particles.n;
     sum->threads = threads;
-    Progress prog;
-    progress_init(&prog, frames);
     if (!cfg->quiet) {
         printf("scene %s (%zu particles, dx %.4g m), solver %s, eps %.1e, %d threads\n", scene.name, scene.particles.n,
                scene.dx, solver->name, cfg->eps, threads);
@@ -334,92 +364,20 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
         printf("%6s %6s %8s %9s %9s %10s %12s  %s\n", "frame", "steps", "outer", "linear", "inner", "wall_s",
                "max_resid", "status");
     }
-    HookCtx hook = {iters_csv, &prog, 0, 0, 0.0};
-    double run_t0 = omp_get_wtime();
-    char deadline_why[64];
-    char stop_reason[300] = "";
-    while (sim.frame < frames && !sum->stopped) {
-        int frame = sim.frame, fsteps = 0, fstatus = SOLVE_CONVERGED;
-        long fouter = 0, flinear = 0, finner = 0;
-        double fwall = 0.0, fmaxres = 0.0;
-        char freason[256] = "";
-        while (sim.frame == frame) {
-            hook.frame = frame;
-            hook.step = fsteps;
-            hook.fraction = (frame + sim.t_in_frame / sim.frame_dt) / frames;
-            set_deadline(cfg, run_t0, &set, deadline_why, sizeof deadline_why);
-            if ((status = run_accuracy_before_step(&acc, &sim, fsteps, &work))) goto done;
-            SolveStats ss;
-            StepInfo si;
-            if ((status = run_step(&sim, solver, &set, &work, iter_hook, &hook, cfg->on_failure == RUN_CONTINUE, &ss,
-                                   &si)))
-                goto done;
-            run_t0 += si.after_solve_s; /* the reference solve is not the run's time either */
-            /* t and dt read back as the same doubles (--dt-from replays them) */
-            fprintf(steps_csv, "%s,%s,%d,%d,%.17g,%.17g,%zu,%d,%lld,%d,%ld,%d,%.6e,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%ld,",
-                    scene.name, solver->name, frame, fsteps, si.t, si.dt, sim.p.n, si.active_nodes,
-                    (long long)ss.hessian_blocks, ss.outer_iters, ss.linear_iters, ss.ls_evals, ss.residual,
-                    solve_status_name(ss.status), si.wall_s, si.begin_s, ss.assemble_s, ss.setup_s, ss.solve_s,
-                    ss.linesearch_s, si.end_s, threads, ss.inner_iters);
-            fprintf(steps_csv, "%.9g,", ss.energy_increase_max);
-            run_accuracy_step_fields(steps_csv, &acc);
-            csv_text(steps_csv, ss.reason); /* the reason stays the last field */
-            fputc('\n', steps_csv);
-            fsteps++;
-            fouter += ss.outer_iters;
-            flinear += ss.linear_iters;
-            finner += ss.inner_iters;
-            fwall += si.wall_s;
-            if (!(ss.residual <= fmaxres)) fmaxres = ss.residual; /* NaN included */
-            if ((int)ss.status > fstatus) snprintf(freason, sizeof freason, "%s", ss.reason);
-            fstatus = worse(fstatus, ss.status);
-            if (!si.advanced) { /* a failure the policy does not (or cannot) go past */
-                snprintf(stop_reason, sizeof stop_reason, "frame %d step %d failed: %s", frame, fsteps - 1, ss.reason);
-                sum->stopped = 1;
-                break;
-            }
-            if (cfg->max_run_s > 0 && omp_get_wtime() - run_t0 >= cfg->max_run_s) {
-                /* the run's budget is spent: this step was the last */
-                snprintf(stop_reason, sizeof stop_reason, "time limit --max-run-seconds %g reached at frame %d step %d",
-                         cfg->max_run_s, frame, fsteps - 1);
-                if (sim.frame == frame && fstatus < SOLVE_TIMEOUT) { /* the frame is cut short */
-                    snprintf(freason, sizeof freason, "%s", stop_reason);
-                    fstatus = SOLVE_TIMEOUT;
-                }
-                sum->stopped = 1;
-                break;
-            }
-        }
-        fprintf(frames_csv, "%s,%s,%d,%d,%ld,%ld,%.6f,%.6e,%s,%d,%ld,", scene.name, solver->name, frame, fsteps, fouter,
-                flinear, fwall, fmaxres, solve_status_name((SolveStatus)fstatus), threads, finner);
-        int acc_status = run_accuracy_frame_end(&acc, &sim, frame, fsteps, sim.frame > frame, frames_csv);
-        csv_text(frames_csv, freason);
-        fputc('\n', frames_csv);
-        if ((status = acc_status)) goto done;
-        fflush(steps_csv);
-        fflush(frames_csv);
-        progress_clear(&prog);
-        if (!cfg->quiet)
-            printf("%6d %6d %8ld %9ld %9ld %10.3f %12.3e  %s\n", frame, fsteps, fouter, flinear, finner, fwall, fmaxres,
-                   solve_status_name((SolveStatus)fstatus));
-        fflush(stdout);
-        if (cfg->particles_dir && !sum->stopped) {
-            char path[1200];
-            snprintf(path, sizeof path, "%s/frame_%04d.ply", cfg->particles_dir, frame + 1);
-            if ((status = ply_write_particles(path, &sim.p))) goto done;
-        }
-        sum->frames++;
-        sum->steps += fsteps;
-        sum->outer_iters += fouter;
-        sum->linear_iters += flinear;
-        sum->inner_iters += finner;
-        if (fmaxres > sum->max_residual) sum->max_residual = fmaxres;
-        sum->worst_status = worse(sum->worst_status, fstatus);
-    }
+    RunOutput out = {cfg, &scene, solver, &acc, steps_csv, frames_csv, iters_csv, threads};
+    FrameDriver driver = {.frames = frames,
+                          .apply_failed = cfg->on_failure == RUN_CONTINUE,
+                          .max_step_s = cfg->max_step_s,
+                          .max_run_s = cfg->max_run_s,
+                          .before_step = before_step,
+                          .after_step = write_step,
+                          .after_frame = write_frame,
+                          .iteration = write_iteration,
+                          .ctx = &out};
+    char stop_reason[300];
+    if ((status = frame_driver_run(&driver, &sim, solver, &set, sum, stop_reason, sizeof stop_reason))) goto done;
     fflush(steps_csv);
     fflush(frames_csv);
-    progress_clear(&prog);
-    sum->wall_s = omp_get_wtime() - run_t0;
     if (sum->stopped) fprintf(stderr, "mpmbench: run stopped: %s\n", stop_reason);
     if (!cfg->quiet) {
         printf("total: %d frames, %d steps, %ld outer, %ld linear, %ld inner iterations, %.3f s wall (%.3f s/frame), "
@@ -452,7 +410,6 @@ done:
     if (steps_csv) fclose(steps_csv);
     if (frames_csv) fclose(frames_csv);
     if (iters_csv) fclose(iters_csv);
-    free(work.dv);
     run_accuracy_free(&acc);
     sim_free(&sim);
     solver_destroy(solver);

@@ -1,0 +1,113 @@
+/* The frame driver (frame_driver.h). */
+#include "experiments/run/frame_driver.h"
+
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "experiments/run/progress.h"
+
+typedef struct {
+    const FrameDriver *d;
+    Progress *progress;
+    int frame, step;
+    double fraction;
+} Iteration;
+
+static void on_iteration(void *ctx, int iter, double elapsed, double residual, double energy)
+{
+    Iteration *h = ctx;
+    if (h->d->iteration) h->d->iteration(h->d->ctx, h->frame, h->step, iter, elapsed, residual, energy);
+    progress_update(h->progress, h->fraction, h->frame, h->step, iter, residual, elapsed);
+}
+
+static int worse(int a, int b) { return a > b ? a : b; } /* SolveStatus is ordered by severity */
+
+/* The deadline of the next solve: the earlier of the step's and the run's. */
+static void set_deadline(const FrameDriver *d, double run_t0, SolveSettings *set, char *why, size_t len)
+{
+    double now = omp_get_wtime();
+    set->deadline = 0.0;
+    set->deadline_reason = why;
+    why[0] = '\0';
+    if (d->max_step_s > 0) {
+        set->deadline = now + d->max_step_s;
+        snprintf(why, len, "--max-step-seconds %g", d->max_step_s);
+    }
+    if (d->max_run_s > 0 && (set->deadline == 0.0 || run_t0 + d->max_run_s < set->deadline)) {
+        set->deadline = run_t0 + d->max_run_s;
+        snprintf(why, len, "--max-run-seconds %g", d->max_run_s);
+    }
+}
+
+int frame_driver_run(const FrameDriver *d, Simulation *sim, Solver *solver, SolveSettings *set, RunSummary *sum,
+                     char *stop_reason, size_t reason_len)
+{
+    int status = MPM_OK;
+    StepWork work = {.dv = NULL, .cap = 0};
+    Progress prog;
+    progress_init(&prog, d->frames);
+    Iteration hook = {d, &prog, 0, 0, 0.0};
+    char deadline_why[64];
+    stop_reason[0] = '\0';
+    double run_t0 = omp_get_wtime();
+    while (sim->frame < d->frames && !sum->stopped) {
+        FrameSums f;
+        memset(&f, 0, sizeof f);
+        f.frame = sim->frame;
+        f.status = SOLVE_CONVERGED;
+        while (sim->frame == f.frame) {
+            hook.frame = f.frame;
+            hook.step = f.steps;
+            hook.fraction = (f.frame + sim->t_in_frame / sim->frame_dt) / d->frames;
+            set_deadline(d, run_t0, set, deadline_why, sizeof deadline_why);
+            if (d->before_step && (status = d->before_step(d->ctx, sim, f.frame, f.steps, &work))) goto done;
+            SolveStats ss;
+            StepInfo si;
+            if ((status = run_step(sim, solver, set, &work, on_iteration, &hook, d->apply_failed, &ss, &si))) goto done;
+            run_t0 += si.after_solve_s; /* a reference solve is not the run's time */
+            if (d->after_step && (status = d->after_step(d->ctx, sim, f.frame, f.steps, &ss, &si))) goto done;
+            f.steps++;
+            f.outer_iters += ss.outer_iters;
+            f.linear_iters += ss.linear_iters;
+            f.inner_iters += ss.inner_iters;
+            f.wall_s += si.wall_s;
+            if (!(ss.residual <= f.max_residual)) f.max_residual = ss.residual; /* NaN included */
+            if ((int)ss.status > f.status) snprintf(f.reason, sizeof f.reason, "%s", ss.reason);
+            f.status = worse(f.status, ss.status);
+            if (!si.advanced) { /* a failure the policy does not (or cannot) go past */
+                snprintf(stop_reason, reason_len, "frame %d step %d failed: %s", f.frame, f.steps - 1, ss.reason);
+                sum->stopped = 1;
+                break;
+            }
+            if (d->max_run_s > 0 && omp_get_wtime() - run_t0 >= d->max_run_s) {
+                /* the run's budget is spent: this step was the last */
+                snprintf(stop_reason, reason_len, "time limit --max-run-seconds %g reached at frame %d step %d",
+                         d->max_run_s, f.frame, f.steps - 1);
+                if (sim->frame == f.frame && f.status < SOLVE_TIMEOUT) { /* the frame is cut short */
+                    snprintf(f.reason, sizeof f.reason, "%s", stop_reason);
+                    f.status = SOLVE_TIMEOUT;
+                }
+                sum->stopped = 1;
+                break;
+            }
+        }
+        f.completed = sim->frame > f.frame;
+        progress_clear(&prog);
+        if (d->after_frame && (status = d->after_frame(d->ctx, sim, &f, sum->stopped))) goto done;
+        sum->frames++;
+        sum->steps += f.steps;
+        sum->outer_iters += f.outer_iters;
+        sum->linear_iters += f.linear_iters;
+        sum->inner_iters += f.inner_iters;
+        if (f.max_residual > sum->max_residual) sum->max_residual = f.max_residual;
+        sum->worst_status = worse(sum->worst_status, f.status);
+    }
+    sum->wall_s = omp_get_wtime() - run_t0;
+done:
+    progress_clear(&prog);
+    free(work.dv);
+    return status;
+}
