@@ -289,7 +289,8 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
                        "inner_iters,max_energy_rise,%s,reason\n",
             run_accuracy_step_header);
     fprintf(frames_csv,
-            "scene,solver,frame,steps,outer_iters,linear_iters,wall_s,max_residual,status,threads,inner_iters,%s,reason\n",
+            "scene,solver,frame,steps,outer_iters,linear_iters,wall_s,max_residual,status,threads,inner_iters,complete,%s,"
+            "reason\n",
             run_accuracy_frame_header);
     if (iters_csv) fprintf(iters_csv, "frame,step,iter,elapsed_s,residual,energy\n");
 
@@ -361,8 +362,9 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
                 break;
             }
         }
-        fprintf(frames_csv, "%s,%s,%d,%d,%ld,%ld,%.6f,%.6e,%s,%d,%ld,", scene.name, solver->name, frame, fsteps, fouter,
-                flinear, fwall, fmaxres, solve_status_name((SolveStatus)fstatus), threads, finner);
+        /* complete 0: the run's time limit cut the frame short (not a frame to time) */
+        fprintf(frames_csv, "%s,%s,%d,%d,%ld,%ld,%.6f,%.6e,%s,%d,%ld,%d,", scene.name, solver->name, frame, fsteps, fouter,
+                flinear, fwall, fmaxres, solve_status_name((SolveStatus)fstatus), threads, finner, sim.frame > frame);
         int acc_status = run_accuracy_frame_end(&acc, &sim, frame, fsteps, sim.frame > frame, frames_csv);
         csv_text(frames_csv, freason);
         fputc('\n', frames_csv);
