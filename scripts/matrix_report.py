@@ -478,7 +478,8 @@ def profile_figure(plt, ratios, order):
     ax.set_xscale("log", base=2)
     ax.set_xlim(1.0, tau_max)
     from matplotlib.ticker import ScalarFormatter
-    ax.xaxis.set_major_formatter(ScalarFormatter())
+    from matplotlib.ticker import FuncFormatter
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
     ax.set_ylim(0.0, 1.03)
     legend_outside(fig, ax, n_solvers)
     return fig, ax
