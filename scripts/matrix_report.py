@@ -450,6 +450,19 @@ def legend_height(n, width_in):
     return legend_rows(n, width_in)[1] * LEGEND_ROW_IN + 0.1
 
 
+def plain_log_y(ax):
+    """Log y axis with tick labels as plain numbers (2, 5, 10 rather than 2 x 10^0); minor ticks
+    at 2 and 5 labelled when the data span less than two decades."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+    lo, hi = ax.get_ylim()
+    ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    if lo > 0 and hi / lo < 100:
+        ax.yaxis.set_minor_locator(LogLocator(base=10, subs=(2.0, 5.0)))
+        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    else:
+        ax.yaxis.set_minor_formatter(NullFormatter())
+
+
 def profile_figure(plt, ratios, order):
     """The step curves rho_s(tau) of a Dolan-More profile from {solver: [ratios]} (inf = never),
     on a log2 tau axis; (None, None) with fewer than two solvers or no finite ratio."""
@@ -648,6 +661,7 @@ def case_figure(plt, root, index, title, cs, order):
             ax.text(first / 2 - 0.5, 0.98, "not timed", transform=ax.get_xaxis_transform(), ha="center", va="top",
                     fontsize=style.FONT_PT - 1, color="0.4")
         ax.set_yscale("log")
+        plain_log_y(ax)
         ax.xaxis.set_major_locator(MaxNLocator(integer=True))
         ax.set_xlabel("frame")
         ax.set_ylabel("wall seconds per frame")
@@ -716,6 +730,7 @@ def stiffness_plots(plt, root, cells, cols, meta, order, md):
             a.set_xlabel("Young's modulus [Pa]")
             a.set_ylabel(lab)
         a1.set_yscale("log")
+        plain_log_y(a1)
         legend_outside(fig, a1)
         fig.suptitle(title, fontsize=style.FONT_PT + 1)
         path = save(fig, root, f"stiffness_{i:02d}_{slug(title)}.png")
@@ -857,9 +872,10 @@ def solver_summary(cases, order, baseline):
     return out, n_fast
 
 
-def answer_lines(summary, n_fast, order, baseline, cells, cases, repeat, dropped, compared, extra):
-    """The report's first lines (markdown bullets), every number computed from the cells."""
-    lines = []
+def answer_lines(summary, n_fast, order, baseline, cells, cases, repeat, dropped, compared, extra, lead=()):
+    """The report's first lines (markdown bullets), every number computed from the cells; `lead`
+    are the lines of the study's own question (robustness, accuracy), which come first."""
+    lines = list(lead)
     ranked = sorted(order, key=lambda s: (-summary[s]["fastest"], -geomean(summary[s]["ratios"])))
     if n_fast and len(order) > 1:
         w = ranked[0]
@@ -930,7 +946,7 @@ def stiffness_answer(ends, order):
         return None
     parts.sort()
     least, most = parts[0], parts[-1]
-    return (f"Stiffness: from E = {e0:g} to {e1:g} Pa, s/frame changes least for {least[1]} ({fmt(least[0])}x) and "
+    return (f"Stiffness: from E = {e0:.0e} to {e1:.0e} Pa, s/frame changes least for {least[1]} ({fmt(least[0])}x) and "
             f"most for {most[1]} ({fmt(most[0])}x).")
 
 
@@ -1139,9 +1155,10 @@ def main(argv):
 
     # ---- the answer first
     summary, n_fast = solver_summary(cases, order, baseline)
-    extra = [x for x in (rb_answer, wp_answer, stiffness_answer(ends, order), mg_answer(levels_by_case),
-                         iterations_answer(cases, order)) if x]
-    lines = answer_lines(summary, n_fast, order, baseline, cells, cases, repeat, dropped, compared, extra)
+    lead = [x for x in (rb_answer, wp_answer) if x]
+    extra = [x for x in (stiffness_answer(ends, order), mg_answer(levels_by_case), iterations_answer(cases, order))
+             if x]
+    lines = answer_lines(summary, n_fast, order, baseline, cells, cases, repeat, dropped, compared, extra, lead)
     md = [f"# {meta.get('name', '?')}: what it found\n"]
     md += [f"- {x}" for x in lines]
     md.append("\n## Summary\n")

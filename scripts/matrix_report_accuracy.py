@@ -289,8 +289,16 @@ def robustness(plt, root, md_fig, md, order, helpers):
     keys = [k for k in rows[0] if k not in fixed]
     keys = [k for k in keys if k == "scene" or len({r.get(k, "") for r in rows}) > 1]
     grid, cases = {}, []
+    def case_of(r):
+        # a named axis whose value already names the scene ("case": "bar3 E_mid=1e4") is shown alone
+        parts = [f"{k}={r[k]}" if not r[k].startswith(r.get("scene", "") + " ") else r[k]
+                 for k in keys if k != "scene"]
+        if any(not p.startswith(f"{k}=") for p, k in zip(parts, [k for k in keys if k != "scene"])):
+            return " ".join(parts)
+        return " ".join([r.get("scene", "")] + parts)
+
     for r in rows:
-        case = " ".join([r.get("scene", "")] + [f"{k}={r[k]}" for k in keys if k != "scene"])
+        case = case_of(r)
         if case not in cases:
             cases.append(case)
         grid[(case, r["solver"])] = r
@@ -315,7 +323,7 @@ def robustness(plt, root, md_fig, md, order, helpers):
     if fails:
         md.append("\nFailing cells:\n")
         for r in fails:
-            case = " ".join([r.get("scene", "")] + [f"{k}={r[k]}" for k in keys if k != "scene"])
+            case = case_of(r)
             md.append(f"- {case} / {r['solver']} ({r['id']}): {r['reasons']}")
         md.append("")
     # the grid as a table-figure: one row per case, the status word in each cell
