@@ -213,14 +213,13 @@ def work_precision(plt, root, cells, cols, order, md_fig, md, helpers):
         axes = list(axes) if panels == 2 else [axes]
         a1 = axes[0]
         names = list(lines)
+        labels = []
         for s, pts in lines.items():
             kw = style.line_kwargs(s, names, ms=3.5)
             e = [(c.err_h, c.timed_wall, c) for c in pts if math.isfinite(c.err_h) and c.err_h > 0]
             if e:
                 a1.plot([x for x, _, _ in e], [y for _, y, _ in e], **kw)
-                for x, y, c in e:  # each point labelled by its eps
-                    a1.annotate(f"{_num(c.row.get('eps')):.0e}".replace("e-0", "e-"), (x, y), textcoords="offset points",
-                                xytext=(3, 2), fontsize=style.FONT_PT - 2.5, color=kw["color"])
+                labels.append((kw["color"], e))
             if panels == 2:
                 p = [(c.pos_rms, c.timed_wall) for c in pts if math.isfinite(c.pos_rms) and c.pos_rms > 0]
                 if p:
@@ -234,8 +233,9 @@ def work_precision(plt, root, cells, cols, order, md_fig, md, helpers):
         if a1.lines:
             for target in TARGETS:
                 a1.axvline(target, ls="--", color="0.6", lw=0.7)
-                a1.annotate(f"{target:g}", xy=(target, 1.0), xycoords=("data", "axes fraction"), ha="center",
-                            va="bottom", fontsize=style.FONT_PT - 2, color="0.4")
+                a1.annotate(f"{target:.0e}".replace("e-0", "e-"), xy=(target, 1.0), xycoords=("data", "axes fraction"),
+                            ha="center", va="bottom", fontsize=style.FONT_PT - 2, color="0.4")
+            _label_eps(fig, a1, labels, style.FONT_PT - 2.5)
         for a in axes:
             if not a.lines:
                 a.text(0.5, 0.5, "no positive errors", ha="center", va="center", transform=a.transAxes)
@@ -254,6 +254,21 @@ def work_precision(plt, root, cells, cols, order, md_fig, md, helpers):
     if problems:
         _profile(plt, root, problems, order, md_fig, helpers)
     return _wp_answer(problems, fmt)
+
+
+def _label_eps(fig, ax, lines, size):
+    """Each point labelled by its eps, in the line's colour, leaving out a label that would
+    overlap one already placed (points nearer than about one label in display space)."""
+    fig.canvas.draw()  # the final limits, so data map to display coordinates
+    placed = []
+    for colour, pts in lines:
+        for x, y, c in pts:
+            px, py = ax.transData.transform((x, y))
+            if any(abs(px - qx) < 26 and abs(py - qy) < 9 for qx, qy in placed):
+                continue
+            placed.append((px, py))
+            ax.annotate(f"{_num(c.row.get('eps')):.0e}".replace("e-0", "e-"), (x, y), textcoords="offset points",
+                        xytext=(3, 2), fontsize=size, color=colour)
 
 
 def _wp_answer(problems, fmt):
