@@ -10,6 +10,7 @@ mg_levels.csv; every table is read by column name). Writes
 
   DIR/report.md        the answer, one summary table, the figures, the detail;
   DIR/report.csv       one row per (case, solver) of the tables;
+  DIR/summary.json     the answer lines and the summary table's numbers, for scripts;
   DIR/profile.csv      the performance-profile ratios (case, solver, ratio) of
                        the cases the profile compares;
   DIR/figures/*.png    with an .svg of the same figure beside each.
@@ -939,6 +940,10 @@ def ratio_text(rs):
             f"{fmt(min(rs))}x to {fmt(max(rs))}x)")
 
 
+def _json_num(x):
+    return round(x, 6) if x is not None and math.isfinite(x) else None
+
+
 def stiffness_answer(ends, order):
     if not ends:
         return None
@@ -1167,6 +1172,24 @@ def main(argv):
     extra = [x for x in (stiffness_answer(ends, order), mg_answer(levels_by_case), iterations_answer(cases, order))
              if x]
     lines = answer_lines(summary, n_fast, order, baseline, cells, cases, repeat, dropped, compared, extra, lead)
+    # the same numbers for scripts (the README's numbers are filled in from these)
+    with open(os.path.join(root, "summary.json"), "w") as f:
+        json.dump({"name": meta.get("name", ""), "baseline": baseline, "repeat": repeat,
+                   "cells": len(runs), "cases": len(cases),
+                   "status": {k: v for k, v in sorted(counts.items())},
+                   "machine_busy": sum(1 for c in runs if c.busy),
+                   "profile_cases": compared, "profile_left_out": len(dropped),
+                   "answer": lines,
+                   "solvers": {s: {"cases": summary[s]["cases"], "ended_ok_converged": summary[s]["clean"],
+                                   "fastest_in": summary[s]["fastest"], "fastest_of": n_fast,
+                                   "speedup_geomean": _json_num(geomean(summary[s]["ratios"])),
+                                   "speedup_min": _json_num(min(summary[s]["ratios"], default=float("nan"))),
+                                   "speedup_max": _json_num(max(summary[s]["ratios"], default=float("nan"))),
+                                   "speedup_cases": len(summary[s]["ratios"]),
+                                   "faster": summary[s]["faster"], "slower": summary[s]["slower"],
+                                   "within_noise": summary[s]["noise"],
+                                   "check_passed": list(check_pass[s]) if check_pass and s in check_pass else None}
+                               for s in order}}, f, indent=1)
     md = [f"# {meta.get('name', '?')}: what it found\n"]
     md += [f"- {x}" for x in lines]
     md.append("\n## Summary\n")
@@ -1181,7 +1204,7 @@ def main(argv):
     md += md_detail
     with open(os.path.join(root, "report.md"), "w") as f:
         f.write("\n".join(md) + "\n")
-    print(f"wrote {root}/report.md, report.csv, profile.csv and {root}/figures/")
+    print(f"wrote {root}/report.md, report.csv, summary.json, profile.csv and {root}/figures/")
     return 0
 
 

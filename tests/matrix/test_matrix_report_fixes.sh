@@ -129,6 +129,14 @@ assert heads == ["## Summary", "## Figures", "## Detail"], heads
 PY
 check "10. the caveats line counts the time-limit cell" grep -q "^- Caveats: 1 of 18 cells did not end ok (1 time-limit)" "$md"
 check "10. single runs: ratios within 1.1x not claimed" grep -q "every cell ran once" "$md"
+check "10. summary.json: the answer's numbers for scripts" python3 - "$d/summary.json" "$md" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+f = s["solvers"]["fast"]
+assert (f["fastest_in"], f["fastest_of"], s["cells"], s["status"]) == (5, 5, 18, {"ok": 17, "time-limit": 1}), s
+assert s["answer"][0] in open(sys.argv[2]).read(), s["answer"][0]
+assert s["profile_cases"] == 4 and s["profile_left_out"] == 3, s
+PY
 
 # ---- repeats and machine load (the new columns)
 d="$tmp/new"
