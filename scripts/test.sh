@@ -8,6 +8,14 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
+# what only the tests need: VTK's Python reader (tests/cli/test_vtk.sh reads the ParaView output back)
+if ! dpkg-query -W -f='${Status}' python3-vtk9 2>/dev/null | grep -q "install ok installed"; then
+  echo "test.sh: installing python3-vtk9" >&2
+  sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends python3-vtk9 >/dev/null
+fi
 t0=$SECONDS
 ctest --test-dir build --output-on-failure -j2 "$@"
 echo "test.sh: release suite $((SECONDS - t0)) s" >&2

@@ -2,6 +2,7 @@
  * shares (see inverse_approx.h). */
 #include "solvers/inverse_approx.h"
 
+#include <omp.h>
 #include <string.h>
 
 #include "core/error.h"
@@ -31,8 +32,11 @@ int inv_setup(InvApprox *M, const InvSetupInput *in)
 {
     M->inner_banked += M->stats.inner_iters; /* the implementation restarts its count */
     M->stats.inner_iters = 0;
+    M->stats.apply_s = 0.0;
     M->ready = 0;
+    double t0 = omp_get_wtime();
     int st = M->ops->setup(M, in);
+    M->stats.setup_s = omp_get_wtime() - t0;
     M->ready = st == MPM_OK;
     return st;
 }
@@ -40,7 +44,10 @@ int inv_setup(InvApprox *M, const InvSetupInput *in)
 int inv_apply(InvApprox *M, const double *r, double *z)
 {
     if (!M->ready) return mpm_error(MPM_EINTERNAL, "%s: applied without a successful setup", M->ops->name);
-    return M->ops->apply(M, r, z);
+    double t0 = omp_get_wtime();
+    int st = M->ops->apply(M, r, z);
+    M->stats.apply_s += omp_get_wtime() - t0;
+    return st;
 }
 
 void inv_view(const InvApprox *M, FILE *f, InvView *out)

@@ -97,6 +97,10 @@ typedef struct {
      * (when not NULL; zeroed by the caller). */
     void (*view)(const InvApprox *self, FILE *f, InvView *out);
     void (*destroy)(InvApprox *self);
+    /* One-time start-up of the library behind the implementation (MPI and
+     * hypre, CHOLMOD), run by the run layer before the first step so that no
+     * step is charged with it (startup_s); NULL: nothing to start. */
+    int (*library_startup)(void);
 } InvApproxOps;
 
 struct InvApprox {

@@ -32,6 +32,52 @@ int solve_end(SolveStats *st, SolveStatus status, const char *fmt, ...)
     return 1;
 }
 
+int solve_past_deadline(const SolveCtx *c) { return c->set->deadline > 0 && omp_get_wtime() >= c->set->deadline; }
+
+void solve_report_iteration(SolveCtx *c, int it, double residual, double E)
+{
+    if (c->hook) c->hook(c->hook_ctx, it, omp_get_wtime() - c->t_start, residual, E);
+}
+
+double solve_energy(SolveCtx *c, const double *dv, SolveStats *st)
+{
+    double t0 = omp_get_wtime();
+    double E = problem_energy(c->pb, dv);
+    st->ls_evals++;
+    st->linesearch_s += omp_get_wtime() - t0;
+    return E;
+}
+
+void solve_gradient(SolveCtx *c, const double *dv, double *g, SolveStats *st)
+{
+    double t0 = omp_get_wtime();
+    problem_gradient(c->pb, dv, g);
+    st->linesearch_s += omp_get_wtime() - t0;
+}
+
+double solve_evaluate(SolveCtx *c, const double *dv, double *g, SolveStats *st)
+{
+    double E = solve_energy(c, dv, st);
+    solve_gradient(c, dv, g, st);
+    return E;
+}
+
+int solve_pcg(SolveCtx *c, const LinearOp *op, const Projection *proj, const double *b, double *x,
+              const PcgOptions *opt, PcgWork *work, PcgResult *res, SolveStats *st)
+{
+    int status = pcg_solve(op, c->inv, proj, b, x, opt, work, res);
+    st->linear_iters += res->iters;
+    return status;
+}
+
+int solve_minres(SolveCtx *c, const LinearOp *op, const Projection *proj, const double *b, double *x,
+                 const MinresOptions *opt, MinresWork *work, MinresResult *res, SolveStats *st)
+{
+    int status = minres_solve(op, c->inv, proj, b, x, opt, work, res);
+    st->linear_iters += res->iters;
+    return status;
+}
+
 int solve_should_stop(SolveCtx *c, const double *g, double E, int it, SolveStats *st)
 {
     double res = problem_cn_residual(c->pb, g);
@@ -102,11 +148,7 @@ int solve_assemble_unprojected(SolveCtx *c, Bsr *H, double *diag, SolveStats *st
     return assemble(c, 0, H, diag, st);
 }
 
-double solve_gradient_tolerance(const SolveCtx *c)
-{
-    if (strcmp(c->stop->name, "l2") == 0) return c->stop_tol;
-    return problem_tau(c->pb, c->stop_tol);
-}
+double solve_gradient_tolerance(const SolveCtx *c) { return c->stop->gradient_tolerance(c->pb, c->stop_tol); }
 
 int solve_setup_inverse(SolveCtx *c, const Bsr *H, const double *diag, const LinearOp *op, const Projection *proj,
                         SolveStats *st)

@@ -7,11 +7,17 @@
  * inverse approximation, the line-search strategy (solvers/line_search.h)
  * and the stopping rule (solvers/stop_rule.h) chosen by options, the caps and
  * time limit, and the iteration hook. It calls the helpers below so that
- * every method stops, times and counts by the same rules:
+ * every method stops, times and counts by the same rules; a method never
+ * reads a clock or counts work itself (the way PETSc times KSPSolve and
+ * PCApply in the wrapper, not in each implementation):
  *  - solve_should_stop() at the top of every iteration (convergence, the
  *    outer cap, the time limit, stagnation, non-finite values);
- *  - solve_assemble() / solve_setup_inverse() / solve_line_search() for the
- *    phases timed in SolveStats.
+ *  - solve_energy() / solve_gradient() / solve_evaluate(),
+ *    solve_assemble(), solve_setup_inverse(), solve_line_search(),
+ *    solve_pcg() and solve_minres() for the phases timed and the work
+ *    counted in SolveStats; solver_solve() charges the rest of the solve's
+ *    wall time (the direction: Krylov solves, the two-loop recursion) to
+ *    solve_s.
  * Adding an outer method is one new file defining its OuterMethodOps and one
  * line in experiments/run/registry.c; tests/conformance/test_conformance.c then checks it
  * (when it claims OUTER_TO_TOLERANCE: reaches eps, honours the cap with
@@ -26,9 +32,10 @@
  *    PCG of a V-cycle, LBFGS-H's PCG), counted by the solver layer;
  *  - phase timers, together covering the solve: assemble_s (tangent
  *    stiffness, Hessian assembly or matrix-free diagonal), setup_s (inverse
- *    approximation setup), solve_s (the direction: PCG, two-loop recursion),
- *    linesearch_s (every energy and gradient evaluation: the initial point,
- *    the line-search trials, the gradient at the accepted point). */
+ *    approximation setup), linesearch_s (every energy and gradient
+ *    evaluation: the initial point, the line-search trials, the gradient at
+ *    the accepted point) and solve_s, the remainder (the direction: PCG,
+ *    two-loop recursion, and the stopping tests). */
 #ifndef MPM_OUTER_METHOD_H
 #define MPM_OUTER_METHOD_H
 
@@ -38,6 +45,8 @@
 #include "core/bsr.h"
 #include "core/problem.h"
 #include "solvers/inverse_approx.h"
+#include "solvers/krylov/minres.h"
+#include "solvers/krylov/pcg.h"
 #include "solvers/line_search.h"
 #include "solvers/options.h"
 #include "solvers/stop_rule.h"
@@ -132,6 +141,24 @@ struct SolveCtx {
  *             for stall_iters iterations (an accepted equal energy counts as
  *             no decrease, so a stagnated solve cannot loop forever). */
 int solve_should_stop(SolveCtx *c, const double *g, double E, int it, SolveStats *st);
+/* 1 when the solve's time limit (set->deadline) has passed. */
+int solve_past_deadline(const SolveCtx *c);
+/* Calls the iteration hook (when set) with the time since the solve began;
+ * for methods whose iterations do not go through solve_should_stop. */
+void solve_report_iteration(SolveCtx *c, int it, double residual, double E);
+/* E(dv), counted in ls_evals and timed as linesearch_s. */
+double solve_energy(SolveCtx *c, const double *dv, SolveStats *st);
+/* g = grad E(dv) (the cache must hold dv: call after solve_energy at dv),
+ * timed as linesearch_s. */
+void solve_gradient(SolveCtx *c, const double *dv, double *g, SolveStats *st);
+/* Both at dv: returns E(dv), fills g. */
+double solve_evaluate(SolveCtx *c, const double *dv, double *g, SolveStats *st);
+/* The outer method's linear solves, their iterations counted in
+ * linear_iters (the arguments are those of pcg_solve and minres_solve). */
+int solve_pcg(SolveCtx *c, const LinearOp *op, const Projection *proj, const double *b, double *x,
+              const PcgOptions *opt, PcgWork *work, PcgResult *res, SolveStats *st);
+int solve_minres(SolveCtx *c, const LinearOp *op, const Projection *proj, const double *b, double *x,
+                 const MinresOptions *opt, MinresWork *work, MinresResult *res, SolveStats *st);
 /* Ends the solve with `status` and a printf-style reason; returns 1. */
 int solve_end(SolveStats *st, SolveStatus status, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 /* The BC-projected Hessian as an operator: assembled H, or matrix-free

@@ -22,6 +22,9 @@ typedef struct {
     /* the quantity compared with the tolerance; cn_residual is
      * problem_cn_residual(pb, g), already computed */
     double (*measure)(const StepProblem *pb, const double *g, double cn_residual);
+    /* the same tolerance as a bound on the plain L2 norm ||g|| (what Gast et
+     * al. 2015 §3.1's forcing term needs as tau_g) */
+    double (*gradient_tolerance)(const StepProblem *pb, double tol);
 } StopRuleOps;
 
 int stop_rule_count(void);

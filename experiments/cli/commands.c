@@ -2,6 +2,7 @@
  * and the matrix commands beside their code. */
 #include "experiments/cli/commands.h"
 
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -75,30 +76,57 @@ static const Command run_command = {
 
 /* ------------------------------------------------------------------ bench */
 
-static const char *const bench_what[] = {"spmv", "assemble", "p2g", "all", NULL};
+static const char *const bench_what[] = {"spmv", "assemble", "hessvec", "p2g", "g2p", "all", NULL};
+static const char *const bench_transfers[] = {"apic", "mls", NULL};
+
+typedef struct {
+    RunConfig run;
+    int transfer; /* index into bench_transfers; -1: the scene's */
+    char transfer_set[32];
+} BenchArgs;
+
+static const Option bench_options[] = {
+    {"--transfer", NULL, "apic|mls", OPT_CHOICE, 0, 0, NULL, bench_transfers, offsetof(BenchArgs, transfer), 0, NULL,
+     0, "the P2G/G2P kernels of APIC or of MLS-MPM (the same as --set transfer=...; default: the scene's)"},
+    {NULL}};
+
 /* the run settings the kernels use: the scene as `run` loads it, and the threads */
 static const char *const bench_settings[] = {"--scene", "--scale", "--threads", "--set", "--asset-dir",
                                              "--max-particles", NULL};
 static const char *const bench_required[] = {"--scene", NULL};
 
+static void bench_init(void *args)
+{
+    BenchArgs *a = args;
+    run_config_default(&a->run);
+    a->transfer = -1;
+}
+
 static int bench_cmd(void *args, const char *what, int *exit_code)
 {
     (void)exit_code;
-    return bench_run(what, args);
+    BenchArgs *a = args;
+    if (a->transfer >= 0) { /* --transfer X is --set transfer=X, given last */
+        snprintf(a->transfer_set, sizeof a->transfer_set, "transfer=%s", bench_transfers[a->transfer]);
+        if (a->run.n_set >= RUN_MAX_LIST) return mpm_error(MPM_EINPUT, "--set: more than %d values", RUN_MAX_LIST);
+        a->run.set[a->run.n_set++] = a->transfer_set;
+    }
+    return bench_run(what, &a->run);
 }
 
 static const Command bench_command = {
     .name = "bench",
-    .operand = "spmv|assemble|p2g|all",
+    .operand = "spmv|assemble|hessvec|p2g|g2p|all",
     .operand_choices = bench_what,
-    .operand_missing = "spmv, assemble, p2g or all",
+    .operand_missing = "spmv, assemble, hessvec, p2g, g2p or all",
     .required = bench_required,
-    .summary = "Kernel throughput on a scene's first time step: block-CSR SpMV against the STREAM triad, the "
-               "matrix-free product, Hessian assembly, P2G; a table, then one key=value line per figure.",
-    .groups = {{run_settings, 0, bench_settings, 0, "run settings"}},
-    .n_groups = 1,
-    .args_size = sizeof(RunConfig),
-    .init = run_init,
+    .summary = "Kernel throughput on a scene's first time step against the machine's limits measured in the same "
+               "process (STREAM triad, FMA peak): block-CSR SpMV, matrix-free H x, Hessian assembly, the P2G and G2P "
+               "transfers; a table, then one key=value line per figure.",
+    .groups = {{bench_options, 0, NULL, 0, NULL}, {run_settings, 0, bench_settings, offsetof(BenchArgs, run), "run settings"}},
+    .n_groups = 2,
+    .args_size = sizeof(BenchArgs),
+    .init = bench_init,
     .run = bench_cmd};
 
 /* ------------------------------------------------------------------ program */

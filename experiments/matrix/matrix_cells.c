@@ -174,10 +174,10 @@ static int in_id(int k, const MatrixCell *c)
 /* The canonical serialisation (JSON, keys in alphabetical order, numbers as
  * the shortest text that reads back the same, so no library's number
  * formatting enters an id) and the id derived from it: the run settings of
- * the table (in_id) and the matrix's first_timed_frame and reference. */
+ * the table (in_id) and the matrix's first_timed_frame, reference and repeat. */
 static int cell_identify(MatrixCell *c)
 {
-    Entry e[RUN_SETTINGS_MAX + 2];
+    Entry e[RUN_SETTINGS_MAX + 3];
     int n = 0;
     for (int k = 0; k < run_settings_count; ++k) {
         if (!in_id(k, c)) continue;
@@ -192,6 +192,11 @@ static int cell_identify(MatrixCell *c)
         e[n].key = "reference";
         e[n].value = (Text){NULL, 0, 0, 0};
         text_string(&e[n++].value, c->ref_id);
+    }
+    if (c->repeat > 1) { /* the first run keeps the id of a matrix without repeat */
+        e[n].key = "repeat";
+        e[n].value = (Text){NULL, 0, 0, 0};
+        text_int(&e[n++].value, c->repeat);
     }
     qsort(e, (size_t)n, sizeof e[0], cmp_entry);
     Text t = {NULL, 0, 0, 0};
@@ -331,6 +336,7 @@ static int build_cell(const Matrix *m, const int *idx, MatrixCell *c)
     c->first_timed_frame = ps && ps->has_first ? ps->first_timed_frame : d->has_first ? d->first_timed_frame : 0;
     c->timeout_s = m->cell_timeout_s;
     c->ref = -1;
+    c->repeat = 1;
     MatrixKvList set = d->set, opts = d->solver_opts;
     int st = ps ? kv_merge(m, scene, &set, &ps->set) : MPM_OK;
     for (int a = 0; a < m->n_named && !st; ++a) {
@@ -429,6 +435,39 @@ static int prepend_references(MatrixCells *out, MatrixCell *refs, int n_refs)
     return MPM_OK;
 }
 
+/* Appends repetitions 2..n of every cell that is not a reference run. */
+static int add_repeats(MatrixCells *out, int n)
+{
+    if (n <= 1) return MPM_OK;
+    int base = out->n, per = 0;
+    for (int i = 0; i < base; ++i) per += !out->cells[i].is_reference;
+    MatrixCell *all = realloc(out->cells, sizeof *all * (size_t)(base + per * (n - 1) + 1));
+    if (!all) return mpm_error(MPM_EINTERNAL, "out of memory (%d cells x %d repeats)", per, n);
+    out->cells = all;
+    for (int k = 2; k <= n; ++k)
+        for (int i = 0; i < base; ++i) {
+            if (all[i].is_reference) continue;
+            MatrixCell *c = &all[out->n];
+            *c = all[i];
+            c->set = c->solver_opts = NULL;
+            c->canonical = NULL;
+            c->repeat = k;
+            MatrixKvList l = {.n = 0};
+            for (int j = 0; j < all[i].n_set; ++j) l.kv[l.n++] = all[i].set[j];
+            int st = copy_kv(&l, &c->set, &c->n_set);
+            l.n = 0;
+            for (int j = 0; j < all[i].n_solver_opts; ++j) l.kv[l.n++] = all[i].solver_opts[j];
+            if (!st) st = copy_kv(&l, &c->solver_opts, &c->n_solver_opts);
+            if (!st) st = cell_identify(c);
+            if (st) {
+                cell_release(c);
+                return st;
+            }
+            out->n++;
+        }
+    return MPM_OK;
+}
+
 int matrix_expand(const Matrix *m, MatrixCells *out)
 {
     memset(out, 0, sizeof *out);
@@ -479,9 +518,12 @@ int matrix_expand(const Matrix *m, MatrixCells *out)
             idx[a] = 0;
         }
     }
-    if (!st) st = prepend_references(out, refs, n_refs);
-    else
+    if (!st) {
+        st = prepend_references(out, refs, n_refs);
+        if (!st) st = add_repeats(out, m->repeat);
+    } else {
         for (int i = 0; i < n_refs; ++i) cell_release(&refs[i]);
+    }
     free(refs);
     return st;
 }
@@ -522,6 +564,7 @@ void matrix_cell_describe(const Matrix *m, const MatrixCell *c, char *out, size_
     if (c->run.error_ref && len < n) len += (size_t)snprintf(out + len, n - len, " error_ref=%s", c->run.error_ref);
     for (int a = 0; a < m->n_named && len < n; ++a)
         len += (size_t)snprintf(out + len, n - len, " %s=%s", m->named[a].name, m->named[a].values[c->value[a]].label);
+    if (c->repeat > 1 && len < n) len += (size_t)snprintf(out + len, n - len, " repeat=%d", c->repeat);
     if (c->is_reference && len < n) len += (size_t)snprintf(out + len, n - len, " (reference run)");
     else if (c->ref_id[0] && len < n) len += (size_t)snprintf(out + len, n - len, " reference=%s", c->ref_id);
 }

@@ -2,8 +2,6 @@
 
 #include <omp.h>
 
-#include "adapters/cholmod.h"
-#include "adapters/boomeramg.h"
 #include "core/error.h"
 
 static double g_startup_s = 0.0;
@@ -17,8 +15,7 @@ int library_startup(const Solver *solver)
     {
     }
     const InvApproxOps *inv = solver && solver->inv ? solver->inv->ops : NULL;
-    if (inv == &inv_boomeramg_ops) st = boomeramg_library_startup();
-    if (!st && inv == &inv_cholmod_ops) st = cholmod_library_startup();
+    if (inv && inv->library_startup) st = inv->library_startup();
     g_startup_s += omp_get_wtime() - t0;
     return st;
 }

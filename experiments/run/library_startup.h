@@ -1,8 +1,8 @@
 /* Library start-up before a run's first step, so that no step is charged
  * with it: the OpenMP thread team, and for the solvers that use them MPI +
- * hypre (MPI_Init, HYPRE_Init) and CHOLMOD. Timed as the run's startup_s
- * (run.json, cells.csv). The one place that maps a solver to the libraries
- * it starts (the registry floor: it knows the adapters). */
+ * hypre (MPI_Init, HYPRE_Init) and CHOLMOD, through the inverse
+ * approximation's library_startup op (no type test: the implementation says
+ * what it needs). Timed as the run's startup_s (run.json, cells.csv). */
 #ifndef MPM_LIBRARY_STARTUP_H
 #define MPM_LIBRARY_STARTUP_H
 

@@ -15,6 +15,7 @@
 #include "experiments/run/library_startup.h"
 #include "experiments/run/paths.h"
 #include "experiments/run/ply.h"
+#include "experiments/run/vtk.h"
 #include "experiments/run/provenance.h"
 #include "experiments/run/registry.h"
 #include "experiments/accuracy/run_accuracy.h"
@@ -103,6 +104,8 @@ int run_config_check(const RunConfig *cfg)
     if ((st = solve_settings_check(&set))) return st;
     if ((st = paths_check_output_dir("--out", cfg->out_dir))) return st;
     if ((st = paths_check_output_dir("--particles", cfg->particles_dir))) return st;
+    if ((st = paths_check_output_dir("--vtk", cfg->vtk_dir))) return st;
+    if (cfg->vtk_grid && !cfg->vtk_dir) return mpm_error(MPM_EINPUT, "--vtk-grid: needs --vtk DIR");
     AccuracyConfig acc = accuracy_config(cfg);
     if ((st = run_accuracy_check(&acc))) return st;
     const char *opts[RUN_MAX_SOLVER_OPTS];
@@ -139,6 +142,7 @@ typedef struct {
     RunAccuracy *acc;
     FILE *steps_csv, *frames_csv, *iters_csv;
     int threads;
+    VtkSeries *vtk;            /* --vtk: the ParaView series, else NULL */
 } RunOutput;
 
 static void write_iteration(void *ctx, int frame, int step, int iter, double elapsed, double residual, double energy)
@@ -176,9 +180,10 @@ static int write_frame(void *ctx, const Simulation *sim, const FrameSums *fs, in
 {
     RunOutput *o = ctx;
     FILE *f = o->frames_csv;
-    fprintf(f, "%s,%s,%d,%d,%ld,%ld,%.6f,%.6e,%s,%d,%ld,", o->scene->name, o->solver->name, fs->frame, fs->steps,
+    /* complete 0: the run's time limit cut the frame short (not a frame to time) */
+    fprintf(f, "%s,%s,%d,%d,%ld,%ld,%.6f,%.6e,%s,%d,%ld,%d,", o->scene->name, o->solver->name, fs->frame, fs->steps,
             fs->outer_iters, fs->linear_iters, fs->wall_s, fs->max_residual, solve_status_name((SolveStatus)fs->status),
-            o->threads, fs->inner_iters);
+            o->threads, fs->inner_iters, fs->completed);
     int status = run_accuracy_frame_end(o->acc, sim, fs->frame, fs->steps, fs->completed, f);
     csv_text(f, fs->reason);
     fputc('\n', f);
@@ -192,8 +197,11 @@ static int write_frame(void *ctx, const Simulation *sim, const FrameSums *fs, in
     if (o->cfg->particles_dir && !stopping) {
         char path[1200];
         snprintf(path, sizeof path, "%s/frame_%04d.ply", o->cfg->particles_dir, fs->frame + 1);
-        return ply_write_particles(path, &sim->p);
+        if ((status = ply_write_particles(path, &sim->p))) return status;
     }
+    if (o->vtk && !stopping)
+        return vtk_series_frame(o->vtk, fs->frame + 1, sim->t, &sim->p, o->scene->materials, o->scene->n_materials,
+                                &sim->grid, sim->vnew);
     return MPM_OK;
 }
 
@@ -337,8 +345,11 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     Simulation sim;
     memset(&sim, 0, sizeof sim);
     FILE *steps_csv = NULL, *frames_csv = NULL, *iters_csv = NULL;
+    VtkSeries vtk;
+    memset(&vtk, 0, sizeof vtk);
     if ((status = paths_mkdir_p(out_dir))) goto done;
     if (cfg->particles_dir && (status = paths_mkdir_p(cfg->particles_dir))) goto done;
+    if (cfg->vtk_dir && (status = vtk_series_open(&vtk, cfg->vtk_dir, cfg->vtk_grid))) goto done;
     if (!(steps_csv = open_in(out_dir, "steps.csv", &status))) goto done;
     if (!(frames_csv = open_in(out_dir, "frames.csv", &status))) goto done;
     if (cfg->history && !(iters_csv = open_in(out_dir, "iters.csv", &status))) goto done;
@@ -350,11 +361,15 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
                        "inner_iters,max_energy_rise,%s,reason\n",
             run_accuracy_step_header);
     fprintf(frames_csv,
-            "scene,solver,frame,steps,outer_iters,linear_iters,wall_s,max_residual,status,threads,inner_iters,%s,reason\n",
+            "scene,solver,frame,steps,outer_iters,linear_iters,wall_s,max_residual,status,threads,inner_iters,complete,%s,"
+            "reason\n",
             run_accuracy_frame_header);
     if (iters_csv) fprintf(iters_csv, "frame,step,iter,elapsed_s,residual,energy\n");
 
     if ((status = sim_init(&sim, &scene))) goto done;
+    if (cfg->vtk_dir && (status = vtk_series_frame(&vtk, 0, sim.t, &sim.p, scene.materials, scene.n_materials, NULL,
+                                                   NULL)))
+        goto done;
     sum->particles = scene.particles.n;
     sum->threads = threads;
     if (!cfg->quiet) {
@@ -364,7 +379,7 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
         printf("%6s %6s %8s %9s %9s %10s %12s  %s\n", "frame", "steps", "outer", "linear", "inner", "wall_s",
                "max_resid", "status");
     }
-    RunOutput out = {cfg, &scene, solver, &acc, steps_csv, frames_csv, iters_csv, threads};
+    RunOutput out = {cfg, &scene, solver, &acc, steps_csv, frames_csv, iters_csv, threads, cfg->vtk_dir ? &vtk : NULL};
     FrameDriver driver = {.frames = frames,
                           .apply_failed = cfg->on_failure == RUN_CONTINUE,
                           .max_step_s = cfg->max_step_s,
@@ -410,6 +425,7 @@ done:
     if (steps_csv) fclose(steps_csv);
     if (frames_csv) fclose(frames_csv);
     if (iters_csv) fclose(iters_csv);
+    vtk_series_free(&vtk);
     run_accuracy_free(&acc);
     sim_free(&sim);
     solver_destroy(solver);

@@ -2,7 +2,6 @@
 #include "solvers/inverse/jacobi.h"
 
 #include <math.h>
-#include <omp.h>
 #include <stdlib.h>
 
 #include "core/error.h"
@@ -59,7 +58,6 @@ static int scalar_create(SolverOptions *opt, InvApprox **out)
 static int jacobi_setup(InvApprox *self, const InvSetupInput *in)
 {
     Jacobi *J = (Jacobi *)self;
-    double t0 = omp_get_wtime();
     self->stats = (InvStats){0};
     int n = in->n_nodes;
     if (!in->diag) return mpm_error(MPM_EINTERNAL, "jacobi: no diagonal given");
@@ -89,14 +87,12 @@ static int jacobi_setup(InvApprox *self, const InvSetupInput *in)
             }
         if (bad < n) st = mpm_error(MPM_ENUMERIC, "scalar jacobi: zero or non-finite diagonal entry at node %d", bad);
     }
-    self->stats.setup_s = omp_get_wtime() - t0;
     return st;
 }
 
 static int jacobi_apply(InvApprox *self, const double *r, double *z)
 {
     Jacobi *J = (Jacobi *)self;
-    double t0 = omp_get_wtime();
     if (!J->scalar) {
         vec_block_apply((size_t)J->n, J->dinv, r, z);
     } else {
@@ -105,7 +101,6 @@ static int jacobi_apply(InvApprox *self, const double *r, double *z)
 #pragma omp parallel for schedule(static)
         for (size_t k = 0; k < len; ++k) z[k] = d[k] * r[k];
     }
-    self->stats.apply_s += omp_get_wtime() - t0;
     return MPM_OK;
 }
 
@@ -126,6 +121,6 @@ static void jacobi_destroy(InvApprox *self)
 
 const InvApproxOps inv_block_jacobi_ops = {"block-jacobi",
                                            "inverse 3x3 diagonal blocks of the Hessian (HOT's default Jacobi)",
-                                           block_create, jacobi_setup, jacobi_apply, jacobi_view, jacobi_destroy};
+                                           block_create, jacobi_setup, jacobi_apply, jacobi_view, jacobi_destroy, NULL};
 const InvApproxOps inv_scalar_jacobi_ops = {"jacobi", "inverse diagonal entries of the Hessian (scalar Jacobi)",
-                                            scalar_create, jacobi_setup, jacobi_apply, jacobi_view, jacobi_destroy};
+                                            scalar_create, jacobi_setup, jacobi_apply, jacobi_view, jacobi_destroy, NULL};

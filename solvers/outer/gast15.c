@@ -50,7 +50,6 @@
 #include "solvers/outer/gast15.h"
 
 #include <math.h>
-#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -140,15 +139,15 @@ static int gast15_create(SolverOptions *opt, OuterMethod **out)
 /* §3.1 "Initial guess": the smaller-energy of dv = 0 and the explicit step,
  * both with dv's Dirichlet components. Leaves the cache at the choice and
  * returns its energy. */
-static double initial_guess(Gast15 *s, StepProblem *pb, double *dv, SolveStats *st)
+static double initial_guess(Gast15 *s, SolveCtx *c, double *dv, SolveStats *st)
 {
+    StepProblem *pb = c->pb;
     const size_t len = 3 * (size_t)pb->n_nodes;
     const double *vn = pb->grid->v, *m = pb->grid->mass;
     double *rest = s->cand, *tmp = s->dv_new, *g = s->g;
     /* the force at the rest positions of the grid: F_p = F_p^n at dv = -v^n */
     for (size_t k = 0; k < len; ++k) rest[k] = -vn[k];
-    problem_energy(pb, rest);
-    problem_gradient(pb, rest, g);
+    solve_evaluate(c, rest, g, st);
     /* explicit: dv = -v^n - M^-1 g(-v^n) on the free part */
     for (int i = 0; i < pb->n_nodes; ++i)
         for (int d = 0; d < 3; ++d) rest[3 * i + d] = -vn[3 * i + d] - g[3 * i + d] / m[i];
@@ -156,13 +155,11 @@ static double initial_guess(Gast15 *s, StepProblem *pb, double *dv, SolveStats *
     solve_keep_dirichlet(pb, dv, rest, explicit_dv, tmp);
     vec_zero(len, rest);
     solve_keep_dirichlet(pb, dv, rest, rest, tmp); /* dv = 0 on the free part */
-    double E_explicit = problem_energy(pb, explicit_dv);
-    double E_zero = problem_energy(pb, rest); /* the cache is at dv = 0 now */
-    st->ls_evals += 3;
+    double E_explicit = solve_energy(c, explicit_dv, st);
+    double E_zero = solve_energy(c, rest, st); /* the cache is at dv = 0 now */
     if (E_explicit < E_zero) {
         vec_copy(len, explicit_dv, dv);
-        st->ls_evals++;
-        return problem_energy(pb, dv);
+        return solve_energy(c, dv, st);
     }
     vec_copy(len, rest, dv);
     return E_zero;
@@ -179,16 +176,8 @@ static int gast15_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *
     if (status) return status;
     Bsr *H = self->assembled ? &s->H : NULL;
 
-    double t0 = omp_get_wtime();
-    double E;
-    if (s->given_guess) {
-        E = problem_energy(pb, dv);
-        st->ls_evals++;
-    } else {
-        E = initial_guess(s, pb, dv, st);
-    }
-    problem_gradient(pb, dv, s->g);
-    st->linesearch_s += omp_get_wtime() - t0;
+    double E = s->given_guess ? solve_energy(c, dv, st) : initial_guess(s, c, dv, st);
+    solve_gradient(c, dv, s->g, st);
     const double tau = solve_gradient_tolerance(c);
     LinearOp op;
     Projection proj;
@@ -200,7 +189,6 @@ static int gast15_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *
         if ((status = solve_assemble_unprojected(c, H, s->diag, st))) return status;
         if ((status = solve_setup_inverse(c, H, s->diag, &op, &proj, st))) return status;
 
-        double t2 = omp_get_wtime();
         const double gnorm = vec_norm(len, s->g);
         for (size_t k = 0; k < len; ++k) s->rhs[k] = -s->g[k];
         PcgOptions po = {.stop = PCG_RELATIVE_L2,
@@ -208,18 +196,13 @@ static int gast15_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *
                          .max_iters = c->set->max_linear,
                          .deadline = c->set->deadline};
         PcgResult pr;
-        status = pcg_solve(&op, c->inv, &proj, s->rhs, s->p, &po, &s->pcg, &pr);
-        st->linear_iters += pr.iters;
+        status = solve_pcg(c, &op, &proj, s->rhs, s->p, &po, &s->pcg, &pr, st);
         if (!status && pr.timed_out) {
-            st->solve_s += omp_get_wtime() - t2;
             solve_end(st, SOLVE_TIMEOUT, "time limit %s reached in CG at outer iteration %d",
                       c->set->deadline_reason ? c->set->deadline_reason : "", it);
             break;
         }
-        if (status) {
-            st->solve_s += omp_get_wtime() - t2;
-            return status;
-        }
+        if (status) return status;
         s->indefinite += pr.indefinite;
         int dir = gast_downhill_direction(pb->n_nodes, s->mass_metric ? pb->grid->mass : NULL, s->g, s->p, s->kappa,
                                           s->rhs);
@@ -228,7 +211,6 @@ static int gast15_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *
         s->gradient += dir == GAST_DIR_GRADIENT;
         s->clamped += gast_clamp_step(len, s->p, s->max_step);
         double gTp = vec_dot(len, s->g, s->p);
-        st->solve_s += omp_get_wtime() - t2;
 
         int stalled;
         if ((status = solve_take_step(c, dv, &s->g, &s->g_new, s->p, &E, gTp, s->dv_new, st, &stalled))) return status;

@@ -8,7 +8,6 @@
  *
  * Options: window (8): pairs kept, 1..64. */
 #include <math.h>
-#include <omp.h>
 #include <stdlib.h>
 
 #include "core/error.h"
@@ -60,11 +59,7 @@ static int lbfgs_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *s
     int status = solve_reserve(vecs, per, 8, pb->n_nodes, &s->cap);
     if (status) return status;
 
-    double t0 = omp_get_wtime();
-    double E = problem_energy(pb, dv);
-    st->ls_evals++;
-    problem_gradient(pb, dv, s->g);
-    st->linesearch_s += omp_get_wtime() - t0;
+    double E = solve_evaluate(c, dv, s->g, st);
     LinearOp op;
     Projection proj;
     solve_hessian_op(c, &s->H, &op);
@@ -79,7 +74,6 @@ static int lbfgs_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *s
             if ((status = solve_setup_inverse(c, &s->H, s->diag, &op, &proj, st))) return status;
             count = head = 0;
         }
-        double t2 = omp_get_wtime();
         /* two-loop recursion on q = -g */
         double *q = s->q, *d = s->d;
         for (size_t k = 0; k < len; ++k) q[k] = -s->g[k];
@@ -90,10 +84,7 @@ static int lbfgs_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *s
             vec_axpy(len, -s->xi[i], Yi, q);
         }
         status = inv_apply(c->inv, q, d);
-        if (status) {
-            st->solve_s += omp_get_wtime() - t2;
-            return status;
-        }
+        if (status) return status;
         problem_project(pb, d);
         for (int k = count - 1; k >= 0; --k) {
             int i = (head - 1 - k + s->window) % s->window;
@@ -107,7 +98,6 @@ static int lbfgs_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *s
             vec_scale(len, -1.0, d);
             gTd = -vec_dot(len, s->g, s->g);
         }
-        st->solve_s += omp_get_wtime() - t2;
         LineSearchOutcome lr;
         if ((status = solve_line_search(c, dv, s->g, d, E, gTd, s->dv_new, s->g_new, &lr, st))) return status;
         if (lr.stalled) break;

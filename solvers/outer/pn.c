@@ -13,7 +13,6 @@
  * ||g|| the plain L2 norm of the gradient and tau_g the termination
  * tolerance on it (the `tau` of stop=l2). */
 #include <math.h>
-#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -61,11 +60,7 @@ static int pn_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *st)
     if (status) return status;
     Bsr *H = self->assembled ? &s->H : NULL;
 
-    double t0 = omp_get_wtime();
-    double E = problem_energy(pb, dv);
-    st->ls_evals++;
-    problem_gradient(pb, dv, s->g);
-    st->linesearch_s += omp_get_wtime() - t0;
+    double E = solve_evaluate(c, dv, s->g, st);
     const double tau = problem_tau(pb, c->set->eps);
     const double tau_g = solve_gradient_tolerance(c);
     LinearOp op;
@@ -78,7 +73,6 @@ static int pn_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *st)
         if ((status = solve_assemble(c, H, s->diag, st))) return status;
         if ((status = solve_setup_inverse(c, H, s->diag, &op, &proj, st))) return status;
 
-        double t2 = omp_get_wtime();
         for (size_t k = 0; k < len; ++k) s->rhs[k] = -s->g[k];
         PcgOptions po = {.stop = PCG_FORCING, .tau = tau, .max_iters = c->set->max_linear,
                          .deadline = c->set->deadline};
@@ -87,9 +81,7 @@ static int pn_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *st)
             po.rel_tol = fmin(0.5, sqrt(fmax(vec_norm(len, s->g), tau_g)));
         }
         PcgResult pr;
-        status = pcg_solve(&op, c->inv, &proj, s->rhs, s->p, &po, &s->pcg, &pr);
-        st->linear_iters += pr.iters;
-        st->solve_s += omp_get_wtime() - t2;
+        status = solve_pcg(c, &op, &proj, s->rhs, s->p, &po, &s->pcg, &pr, st);
         if (status) return status;
         if (pr.timed_out) {
             solve_end(st, SOLVE_TIMEOUT, "time limit %s reached in PCG at outer iteration %d",

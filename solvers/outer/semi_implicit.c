@@ -31,7 +31,6 @@
  * in; rtol (1e-6): MINRES stops when ||H p + g||_{M^-1} < rtol ||g||_{M^-1};
  * matrix_free (1). */
 #include <math.h>
-#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -75,14 +74,9 @@ static int si_create(SolverOptions *opt, OuterMethod **out)
 /* energy and gradient at dv, the CN residual into st and the hook */
 static double evaluate(SolveCtx *c, const double *dv, double *g, int it, SolveStats *st)
 {
-    double t0 = omp_get_wtime();
-    double E = problem_energy(c->pb, dv);
-    problem_gradient(c->pb, dv, g);
-    st->ls_evals++;
+    double E = solve_evaluate(c, dv, g, st);
     st->residual = problem_cn_residual(c->pb, g);
-    double now = omp_get_wtime();
-    st->linesearch_s += now - t0;
-    if (c->hook) c->hook(c->hook_ctx, it, now - c->t_start, st->residual, E);
+    solve_report_iteration(c, it, st->residual, E);
     return E;
 }
 
@@ -108,7 +102,7 @@ static int si_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *st)
         solve_end(st, SOLVE_FAILED, "non-finite %s at the linearisation point", isfinite(E) ? "residual" : "energy");
         return MPM_OK;
     }
-    if (c->set->deadline > 0 && omp_get_wtime() >= c->set->deadline) {
+    if (solve_past_deadline(c)) {
         solve_end(st, SOLVE_TIMEOUT, "time limit %s reached before the linear solve",
                   c->set->deadline_reason ? c->set->deadline_reason : "");
         return MPM_OK;
@@ -121,13 +115,10 @@ static int si_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *st)
     if ((status = solve_assemble_unprojected(c, H, s->diag, st))) return status;
     if ((status = solve_setup_inverse(c, H, s->diag, &op, &proj, st))) return status;
 
-    double t2 = omp_get_wtime();
     for (size_t k = 0; k < len; ++k) s->rhs[k] = -s->g[k];
     MinresOptions mo = {s->rtol, c->set->max_linear, c->set->deadline};
     MinresResult mr;
-    status = minres_solve(&op, c->inv, &proj, s->rhs, s->p, &mo, &s->mw, &mr);
-    st->linear_iters = mr.iters;
-    st->solve_s += omp_get_wtime() - t2;
+    status = solve_minres(c, &op, &proj, s->rhs, s->p, &mo, &s->mw, &mr, st);
     if (status) return status;
     vec_axpy(len, 1.0, s->p, dv);
 
