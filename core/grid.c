@@ -198,6 +198,7 @@ int grid_build(Grid *g, Stencils *st, Particles *p, double dx)
     int npb = st->pcolor.n_blocks;
 
     /* Weights and gradients (parallel, per particle). */
+    st->mls = 0;
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < np; ++k) {
         double N[3][3], dN[3][3];
@@ -331,6 +332,29 @@ int grid_build(Grid *g, Stencils *st, Particles *p, double dx)
     return MPM_OK;
 oom:
     return mpm_error(MPM_EINTERNAL, "out of memory: %d grid nodes", n);
+}
+
+void stencils_use_mls_gradients(Stencils *st, const Particles *p, double dx)
+{
+    double inv_dx = 1.0 / dx;
+#pragma omp parallel for schedule(static)
+    for (size_t k = 0; k < st->n; ++k) {
+        double N[3][3], dN[3][3], G[3][3];
+        for (int d = 0; d < 3; ++d) {
+            int b = bspline2_1d(p->x[3 * k + d], inv_dx, N[d], dN[d]);
+            mls_factor_1d(p->x[3 * k + d], inv_dx, b, N[d], G[d]);
+        }
+        double *dw = st->dw + 3 * MPM_STENCIL * k;
+        for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b)
+                for (int c = 0; c < 3; ++c) {
+                    int s = stencil_slot(a, b, c);
+                    dw[3 * s] = G[0][a] * N[1][b] * N[2][c];
+                    dw[3 * s + 1] = N[0][a] * G[1][b] * N[2][c];
+                    dw[3 * s + 2] = N[0][a] * N[1][b] * G[2][c];
+                }
+    }
+    st->mls = 1;
 }
 
 void grid_free(Grid *g)

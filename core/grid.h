@@ -46,7 +46,8 @@ typedef struct {
     size_t n, cap;
     int *node;     /* 27 per particle: node id, -1 where the weight is exactly 0 */
     double *w;     /* 27 per particle */
-    double *dw;    /* 81 per particle: weight gradients (27 x 3) */
+    double *dw;    /* 81 per particle: weight gradients (27 x 3), or their MLS substitute */
+    int mls;       /* 1: dw holds the MLS substitute (stencils_use_mls_gradients) */
     NodeColoring pcolor; /* particle blocks (particles sorted by base-node block) */
     int *base;     /* 3 per particle: base node */
     size_t *perm;  /* sort scratch */
@@ -56,6 +57,16 @@ typedef struct {
 /* Sorts particles by base-node block, finds the active nodes, numbers them
  * and fills the stencils. Allocates only when sizes grow. */
 int grid_build(Grid *g, Stencils *st, Particles *p, double dx);
+
+/* MLS-MPM (SPEC 9; Hu et al. 2018 supplement eq. 5-10): replaces each
+ * weight gradient grad w_ip by w_ip D_p^-1 (x_i - x_p), D_p = dx^2/4 I for
+ * the quadratic B-spline, so the force, the F update and the incremental
+ * potential with its gradient, Hessian and H x (core/problem.c reads dw)
+ * become MLS-MPM's. Per axis the substitute is still a tensor product:
+ * component a is g_a(i_a) w_b(i_b) w_c(i_c), g_a(k) = 4/dx (k - f_a) N_a(k)
+ * with f_a = x_a/dx - base_a (kernel.h mls_factor_1d). Sets st->mls; call
+ * after grid_build (which restores the B-spline gradients). */
+void stencils_use_mls_gradients(Stencils *st, const Particles *p, double dx);
 
 /* Node id at integer coordinates, or -1 if not active. */
 int grid_lookup(const Grid *g, const int c[3]);

@@ -22,6 +22,16 @@ static inline int bspline2_1d(double x, double inv_dx, double N[3], double dN[3]
     return base;
 }
 
+/* The MLS-MPM substitute of the 1D gradient factor (Hu et al. 2018
+ * supplement section 2, D_p = dx^2/4 I): G[k] = 4/dx^2 (x_k - x) N[k]
+ * with x_k = (base + k) dx, i.e. 4/dx (k - fx) N[k], fx = x/dx - base.
+ * N as from bspline2_1d at the same x. */
+static inline void mls_factor_1d(double x, double inv_dx, int base, const double N[3], double G[3])
+{
+    double fx = x * inv_dx - (double)base;
+    for (int k = 0; k < 3; ++k) G[k] = 4.0 * inv_dx * ((double)k - fx) * N[k];
+}
+
 /* Stencil slot k in [0,27) <-> offsets (a,b,c) in {0,1,2}^3, c fastest. */
 static inline int stencil_slot(int a, int b, int c) { return 9 * a + 3 * b + c; }
 

@@ -32,7 +32,11 @@
  *                                     affine matrix), so "transfer" can be
  *                                     switched with --set on any scene
  *   "transfer": "apic",               optional: "apic" (default, APIC/RPIC) |
- *                                     "pic_flip" | {"type": "pic_flip",
+ *                                     "mls" (MLS-MPM, SPEC 9: APIC velocities,
+ *                                     grad w_ip replaced by w_ip 4/dx^2 (x_i -
+ *                                     x_p) in the force, the F update and the
+ *                                     potential's derivatives; Hu et al.
+ *                                     2018) | "pic_flip" | {"type": "pic_flip",
  *                                     "alpha": 0.95}: v_p = alpha v_FLIP +
  *                                     (1 - alpha) v_PIC and C_p = 0
  *                                     (Stomakhin et al. 2013; Gast et al.
@@ -227,7 +231,7 @@ typedef struct Scene {
     CflRule cfl_rule;                 /* collider speed rule of the CFL dt (SPEC 12) */
     double gravity[3];
     double apic_ratio;                /* RPIC/APIC blend r (1 = APIC, 0 = RPIC) */
-    TransferKind transfer;            /* "transfer": APIC (default) or PIC/FLIP */
+    TransferKind transfer;            /* "transfer": APIC (default), MLS or PIC/FLIP */
     double flip_alpha;                /* "transfer".alpha (PIC/FLIP only) */
     PositionUpdateKind position_update; /* "position_update" */
     int volumes_from_density;         /* "particle_volume": "grid_density" */

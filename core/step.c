@@ -229,7 +229,12 @@ int step_begin(Simulation *sim)
     else if ((st = sim_next_dt(sim, &sim->dt))) return st;
     sim->dt_next = 0.0;
     if ((st = grid_build(&sim->grid, &sim->st, &sim->p, sc->dx))) return st;
-    transfer_p2g(&sim->grid, &sim->st, &sim->p);
+    if (sc->transfer == TRANSFER_MLS) { /* SPEC 9: MLS gradients everywhere, fused P2G */
+        stencils_use_mls_gradients(&sim->st, &sim->p, sc->dx);
+        transfer_p2g_mls(&sim->grid, &sim->st, &sim->p, NULL);
+    } else {
+        transfer_p2g(&sim->grid, &sim->st, &sim->p);
+    }
     if ((st = check_node_masses(sim))) return st;
     estimate_volumes(sim);
     if ((st = problem_prepare(&sim->pb, &sim->grid, &sim->st, &sim->p, sc->materials, sc->n_materials, sim->dt,

@@ -1,8 +1,10 @@
 /* The two halves of a timestep around the solve (SPEC 2; DESIGN data flow):
  *   step_begin: colliders at t^n, dt from CFL and frame boundaries, particle
- *               sort, sparse grid, P2G, Dirichlet nodes, the step problem;
+ *               sort, sparse grid (MLS: the stencils' gradients become
+ *               the MLS substitute, SPEC 9), P2G (MLS: the fused form),
+ *               Dirichlet nodes, the step problem;
  *   step_end:   v^{n+1} = v^n + dv, Coulomb friction at slip colliders,
- *               G2P (APIC/RPIC or PIC/FLIP, F update, forward-Euler
+ *               G2P (APIC/RPIC, MLS or PIC/FLIP, F update, forward-Euler
  *               advection or the backward-Euler position update),
  *               plasticity (lagged), sources; particles that crossed a
  *               domain wall are held at its face; non-finite state or a

@@ -1,21 +1,50 @@
 /* Particle <-> grid transfers with APIC and the RPIC blend (SPEC 2;
- * Jiang et al. 2015; HOT reference §1.2), the PIC/FLIP blend of Stomakhin
- * et al. 2013 / Gast et al. 2015 section 6.1 step 5, and the particle volumes
- * estimated from the grid density (Gast et al. 2015 section 6.1 step 2). */
+ * Jiang et al. 2015; HOT reference §1.2), MLS-MPM (SPEC 9; Hu et al. 2018
+ * and its supplement), the PIC/FLIP blend of Stomakhin et al. 2013 / Gast
+ * et al. 2015 section 6.1 step 5, and the particle volumes estimated from
+ * the grid density (Gast et al. 2015 section 6.1 step 2). */
 #ifndef MPM_TRANSFER_H
 #define MPM_TRANSFER_H
 
 #include "core/grid.h"
+#include "core/material.h"
 #include "core/particles.h"
 
 /* P2G: m_i = sum_p w_ip m_p, (mv)_i = sum_p w_ip m_p (v_p + C_p (x_i - x_p)),
  * v_i = (mv)_i / m_i. Race-free by particle-block colouring. */
 void transfer_p2g(Grid *g, const Stencils *st, const Particles *p);
 
+/* The explicit particle force of the supplement's benchmark P2G (Hu et al.
+ * 2018 supplement section 3, "Benchmark settings": linear elasticity,
+ * P = mu (F + F^T - 2 I) + lambda tr(F - I) I, from each particle's
+ * material mu and lambda), then v_i = (mv)_i / m_i + dt g. Only the
+ * transfer benchmark uses it; the implicit step keeps the force in the
+ * incremental potential and passes no force. */
+typedef struct {
+    double dt;
+    const Material *mats;
+    double gravity[3];
+} ExplicitForce;
+
+/* APIC P2G with an explicit force from the weight gradients (the
+ * supplement's APIC reference kernel): (mv)_i += w_ip m_p (v_p + C_p (x_i - x_p))
+ * - dt V_p P_p F_p^T grad w_ip. force NULL: transfer_p2g. */
+void transfer_p2g_apic_force(Grid *g, const Stencils *st, const Particles *p, const ExplicitForce *force);
+
+/* Fused MLS-MPM P2G (supplement section 3.1): one affine matrix per particle,
+ *   Q_p = m_p C_p - dt V_p D_p^-1 P_p F_p^T,  D_p^-1 = 4/dx^2 I,
+ *   (mv)_i += w_ip (m_p v_p + Q_p (x_i - x_p)),
+ * so the inner loop over the 27 nodes has one 3x3 product. force NULL
+ * (the implicit step): Q_p = m_p C_p, the APIC momentum of transfer_p2g
+ * up to round-off. */
+void transfer_p2g_mls(Grid *g, const Stencils *st, const Particles *p, const ExplicitForce *force);
+
 /* Which particle velocity G2P stores. */
 typedef enum {
     TRANSFER_APIC = 0,    /* APIC/RPIC: v_p = PIC velocity, C_p from B_p (apic_ratio) */
-    TRANSFER_PIC_FLIP = 1 /* v_p = alpha v_FLIP + (1 - alpha) v_PIC, C_p = 0 */
+    TRANSFER_PIC_FLIP = 1, /* v_p = alpha v_FLIP + (1 - alpha) v_PIC, C_p = 0 */
+    TRANSFER_MLS = 2       /* MLS-MPM: APIC velocities and C_p; the stencils' weight gradients are
+                              the MLS substitute (stencils_use_mls_gradients), F <- (I + dt C'_p) F */
 } TransferKind;
 
 typedef struct {
@@ -26,7 +55,9 @@ typedef struct {
                           moves them, e.g. position_update_backward_euler) */
 } G2POptions;
 
-/* G2P with weights at x_p^n, grid velocities vnew (3n), v^n = g->v:
+/* G2P with weights at x_p^n, grid velocities vnew (3n), v^n = g->v
+ * (MLS: as APIC, but F <- (I + dt C'_p) F with C'_p = 4/dx^2 B_p, the
+ * supplement's eq. 6: no weight gradient is read):
  *   v_PIC = sum w v_i,  grad v_p = sum v_i grad w^T,  F_p <- (I + dt grad v_p) F_p,
  *   APIC:     v_p = v_PIC, B_p = sum w v_i (x_i - x_p)^T, C' = 4/dx^2 B_p,
  *             C_p = (r+1)/2 C' + (r-1)/2 C'^T,

@@ -938,9 +938,12 @@ static int parse_mpm_options(json_t *root, const char *file, Scene *sc)
     } else if (tj) {
         if (json_is_string(tj) && strcmp(json_string_value(tj), "pic_flip") == 0)
             sc->transfer = TRANSFER_PIC_FLIP;
+        else if (json_is_string(tj) && strcmp(json_string_value(tj), "mls") == 0)
+            sc->transfer = TRANSFER_MLS;
         else if (!json_is_string(tj) || strcmp(json_string_value(tj), "apic") != 0)
             return sj_bad(file, "", "transfer",
-                          "expected \"apic\", \"pic_flip\" or {\"type\": \"pic_flip\", \"alpha\": a}", tj);
+                          "expected \"apic\", \"mls\", \"pic_flip\" or {\"type\": \"pic_flip\", \"alpha\": a}",
+                          tj);
     }
     sc->position_update = POSITION_FORWARD_EULER;
     if ((st = sj_string(root, "position_update", 0, file, "", &s, &have))) return st;

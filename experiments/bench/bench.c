@@ -8,30 +8,15 @@
 #include "core/error.h"
 #include "core/step.h"
 #include "core/transfer.h"
-
-/* Repeats fn until at least min_s seconds have passed (and at least 3
- * times); returns the best single time (STREAM convention). */
-typedef void (*BenchFn)(void *ctx);
-static double best_time(BenchFn fn, void *ctx, double min_s)
-{
-    double best = 1e300, start = omp_get_wtime();
-    int reps = 0;
-    while (reps < 3 || omp_get_wtime() - start < min_s) {
-        double t0 = omp_get_wtime();
-        fn(ctx);
-        double t = omp_get_wtime() - t0;
-        if (t < best) best = t;
-        if (++reps > 100000) break;
-    }
-    return best;
-}
+#include "experiments/bench/machine_limits.h"
 
 typedef struct {
     Simulation *sim;
     Bsr *H;
     double *x, *y;
-    double *a, *b, *c;
-    size_t len;
+    double *vnew;
+    ExplicitForce force;
+    G2POptions g2p;
 } BenchCtx;
 
 static void run_spmv(void *ctx)
@@ -44,42 +29,6 @@ static void run_hessvec(void *ctx)
 {
     BenchCtx *b = ctx;
     problem_hessvec(&b->sim->pb, b->x, b->y);
-}
-
-static void run_triad(void *ctx)
-{
-    BenchCtx *b = ctx;
-    double *restrict a = b->a;
-    const double *restrict bb = b->b, *restrict cc = b->c;
-    const double s = 3.0;
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < b->len; ++i) a[i] = bb[i] + s * cc[i];
-}
-
-/* Best time and bandwidth (24 bytes per entry) of the triad over len doubles
- * per array; the arrays live only for the measurement. */
-static int triad(BenchCtx *bc, size_t len, double min_s, double *t, double *gbs)
-{
-    bc->len = len;
-    bc->a = malloc(sizeof(double) * len);
-    bc->b = malloc(sizeof(double) * len);
-    bc->c = malloc(sizeof(double) * len);
-    int status = MPM_OK;
-    if (!bc->a || !bc->b || !bc->c) {
-        status = mpm_error(MPM_EINTERNAL, "out of memory in bench (triad of %zu doubles)", len);
-    } else {
-#pragma omp parallel for schedule(static)
-        for (size_t i = 0; i < len; ++i) {
-            bc->a[i] = 0.0;
-            bc->b[i] = 1.0;
-            bc->c[i] = 2.0;
-        }
-        *t = best_time(run_triad, bc, min_s);
-        *gbs = 24.0 * len / *t / 1e9;
-    }
-    free(bc->a), free(bc->b), free(bc->c);
-    bc->a = bc->b = bc->c = NULL;
-    return status;
 }
 
 static void run_assemble(void *ctx)
@@ -95,10 +44,96 @@ static void run_scatter(void *ctx)
     problem_assemble(&b->sim->pb, b->H);
 }
 
+/* The supplement's P2G (section 3, "Benchmark settings"): force from F,
+ * scatter of mass, force and affine momentum, normalisation and gravity. */
 static void run_p2g(void *ctx)
 {
     BenchCtx *b = ctx;
-    transfer_p2g(&b->sim->grid, &b->sim->st, &b->sim->p);
+    Simulation *s = b->sim;
+    if (s->scene->transfer == TRANSFER_MLS) transfer_p2g_mls(&s->grid, &s->st, &s->p, &b->force);
+    else transfer_p2g_apic_force(&s->grid, &s->st, &s->p, &b->force);
+}
+
+/* The supplement's G2P: velocity and affine field, F update, advection. */
+static void run_g2p(void *ctx)
+{
+    BenchCtx *b = ctx;
+    Simulation *s = b->sim;
+    transfer_g2p_opts(&s->grid, &s->st, &s->p, b->vnew, b->force.dt, &b->g2p);
+}
+
+/* Work and traffic models per particle (flops counted from the loops in
+ * core/transfer.c and core/problem.c, one per add, multiply or divide;
+ * bytes: the particle state each kernel must read and write at least once,
+ * plus the grid arrays once per active node, spread over the particles).
+ * Particle state: x 24, v 24, C 72, F 72, mass 8, vol 8, material 4 bytes. */
+typedef struct {
+    const char *name;
+    double flops, bytes;
+} KernelModel;
+
+static KernelModel model_p2g(int mls, double nodes_per_particle)
+{
+    /* stress 88 (P 25, P F^T 45, times V and dt 18); per node: r 6, C r 15,
+     * APIC: K grad w 15, w m 1, mass 1, momentum 12 -> 50;
+     * MLS: Q = m C - c K 27 extra per particle; per node: r 6, Q r 15, mass 2, momentum 9 -> 32;
+     * normalisation with gravity 7 per node */
+    double per_node_grid = 7.0 * nodes_per_particle;
+    KernelModel m = {mls ? "P2G (MLS fused Q_p)" : "P2G (APIC + force)", 0, 0};
+    m.flops = mls ? 88.0 + 30.0 + 27.0 * 32.0 + per_node_grid : 88.0 + 27.0 * 50.0 + per_node_grid;
+    /* reads x, v, C, F, mass, vol, material (212 B); grid mass and momentum written once and
+     * read back and written by the normalisation (3 x 32 B per node) */
+    m.bytes = 212.0 + 96.0 * nodes_per_particle;
+    return m;
+}
+
+static KernelModel model_g2p(int mls, double nodes_per_particle)
+{
+    /* per node: r 6, v 6, B 18; APIC also grad v 18 -> 30 / 48; per particle: C 9 x 3 (blend),
+     * F update 9 (I + dt G) + 45 (product), advection 6; MLS: G = 4/dx^2 B 9 more */
+    KernelModel m = {mls ? "G2P (MLS, F from C_p)" : "G2P (APIC, F from grad w)", 0, 0};
+    m.flops = mls ? 27.0 * 30.0 + 27.0 + 9.0 + 9.0 + 45.0 + 6.0 : 27.0 * 48.0 + 27.0 + 9.0 + 45.0 + 6.0;
+    /* reads x, F (96 B), writes x, v, C, F (192 B); grid velocity read once (24 B per node) */
+    m.bytes = 96.0 + 192.0 + 24.0 * nodes_per_particle;
+    return m;
+}
+
+static KernelModel model_hessvec(double nodes_per_particle)
+{
+    /* dF = sum_i x_i a_ip^T (27 x 18), A : dF (162), scatter (27 x 18), volume scaling 18;
+     * reads the tangent A (648 B), a_ip (648 B) and V; x read and y written per node (48 B) */
+    KernelModel m = {"matrix-free H x", 27.0 * 18.0 + 162.0 + 27.0 * 18.0 + 18.0, 648.0 + 648.0 + 8.0 + 48.0 * nodes_per_particle};
+    return m;
+}
+
+static KernelModel model_assemble(double blocks_per_particle)
+{
+    /* dP/dF (projected) is not counted (an SVD and eigen-projection per particle);
+     * A a_t for 27 t (27 x 162), a_s^T (A a_t) for the 378 pairs s <= t (x 54);
+     * reads A and a (1296 B), writes the matrix blocks (72 B each) once */
+    KernelModel m = {"assemble (dP/dF + scatter)", 27.0 * 162.0 + 378.0 * 54.0, 1296.0 + 72.0 * blocks_per_particle};
+    return m;
+}
+
+typedef struct {
+    double stream_gbs, peak_machine, peak_build;
+    size_t np;
+    int threads;
+} Limits;
+
+static void report(const Limits *L, KernelModel m, double t, double spread, const char *key)
+{
+    double pps = (double)L->np / t;
+    double gbs = m.bytes * pps / 1e9, gfl = m.flops * pps / 1e9;
+    printf("%-28s %10.3f ms (+%4.1f%%) %10.3g p/s %7.0f B/p %7.2f GB/s %5.1f%% STREAM %7.0f flop/p %7.2f GF/s "
+           "%5.1f%% peak (%5.1f%% build peak)\n",
+           m.name, 1e3 * t, 100.0 * spread, pps, m.bytes, gbs, 100.0 * gbs / L->stream_gbs, m.flops, gfl,
+           100.0 * gfl / L->peak_machine, 100.0 * gfl / L->peak_build);
+    printf("%s_particles_per_s=%.4g\n%s_bytes_per_particle=%.0f\n%s_gbs=%.3f\n%s_stream_fraction=%.4f\n"
+           "%s_flops_per_particle=%.0f\n%s_gflops=%.3f\n%s_peak_fraction=%.4f\n%s_build_peak_fraction=%.4f\n"
+           "%s_spread=%.4f\n",
+           key, pps, key, m.bytes, key, gbs, key, gbs / L->stream_gbs, key, m.flops, key, gfl, key,
+           gfl / L->peak_machine, key, gfl / L->peak_build, key, spread);
 }
 
 int bench_run(const char *what, const RunConfig *cfg)
@@ -121,7 +156,8 @@ int bench_run(const char *what, const RunConfig *cfg)
     double *dv = malloc(sizeof(double) * 3 * (size_t)n);
     bc.x = malloc(sizeof(double) * 3 * (size_t)n);
     bc.y = malloc(sizeof(double) * 3 * (size_t)n);
-    if (!dv || !bc.x || !bc.y) {
+    bc.vnew = malloc(sizeof(double) * 3 * (size_t)n);
+    if (!dv || !bc.x || !bc.y || !bc.vnew) {
         free(dv);
         status = mpm_error(MPM_EINTERNAL, "out of memory in bench");
         goto done;
@@ -132,61 +168,80 @@ int bench_run(const char *what, const RunConfig *cfg)
     problem_tangent(pb, 1);
     if ((status = problem_assemble(pb, &H))) goto done;
     for (int i = 0; i < 3 * n; ++i) bc.x[i] = 1.0 + 1e-3 * (i % 17);
+    for (int i = 0; i < 3 * n; ++i) bc.vnew[i] = sim.grid.v[i] + 1e-3 * ((i % 7) - 3);
     bc.sim = &sim;
     bc.H = &H;
+    bc.force.dt = sim.dt;
+    bc.force.mats = scene.materials;
+    memcpy(bc.force.gravity, scene.gravity, sizeof bc.force.gravity);
+    bc.g2p = (G2POptions){.kind = scene.transfer, .apic_ratio = scene.apic_ratio, .flip_alpha = scene.flip_alpha,
+                          .advect = 1};
     int all = !strcmp(what, "all");
     double min_s = 1.0;
+    const char *tname = scene.transfer == TRANSFER_MLS ? "mls" : scene.transfer == TRANSFER_APIC ? "apic" : "pic_flip";
 
-    printf("bench on %s: %zu particles, %d active nodes, %lld blocks (%.1f per row), %d threads\n", scene.name, np, n,
-           (long long)H.nnzb, (double)H.nnzb / n, threads);
+    printf("bench on %s (transfer %s): %zu particles, %d active nodes, %lld blocks (%.1f per row), %d threads\n",
+           scene.name, tname, np, n, (long long)H.nnzb, (double)H.nnzb / n, threads);
     size_t mat_bytes = bsr_bytes(&H);
     printf("  Hessian storage: %.1f MB, %.0f bytes per active node\n", mat_bytes / 1e6, (double)mat_bytes / n);
-    printf("%-28s %14s %14s\n", "kernel", "time [ms]", "throughput");
-    double spmv_gbs = 0, stream_gbs = 0, stream_dram_gbs = 0, asm_pps = 0, scatter_pps = 0, p2g_pps = 0, mf_gbs_equiv = 0;
+
+    /* machine limits in this process: DRAM triad (3 x 128 MB) and the FMA peak */
+    Limits L = {.np = np, .threads = threads};
+    double ts;
+    if ((status = machine_stream_triad((size_t)16 << 20, min_s, &ts, &L.stream_gbs))) goto done;
+    FlopPeak peak;
+    machine_flop_peak(min_s, &peak);
+    L.peak_machine = peak.gflops_machine;
+    L.peak_build = peak.gflops_build;
+    printf("%-28s %10.3f ms %11.2f GB/s\n", "STREAM triad (384 MB)", 1e3 * ts, L.stream_gbs);
+    printf("%-28s %11.2f GFLOP/s (%s); %.2f GFLOP/s with the build's instructions\n", "floating-point peak",
+           peak.gflops_machine, peak.isa, peak.gflops_build);
+    double npp = (double)n / (double)np;
+    double spmv_gbs = 0, stream_gbs = 0, mf_gbs_equiv = 0, spread = 0;
     if (all || !strcmp(what, "spmv")) {
         /* minimal traffic: matrix arrays once, x and y once */
         double bytes = (double)mat_bytes + 2.0 * 24.0 * n;
-        double t = best_time(run_spmv, &bc, min_s);
+        double t = machine_best_time(run_spmv, &bc, min_s, &spread);
         spmv_gbs = bytes / t / 1e9;
-        printf("%-28s %14.3f %11.2f GB/s\n", "block-CSR SpMV", 1e3 * t, spmv_gbs);
-        /* STREAM triad over a working set of the same size, then one far
-         * beyond any cache (3 x 128 MB): the DRAM bandwidth */
-        double ts;
-        if ((status = triad(&bc, (size_t)(bytes / 24.0), min_s, &ts, &stream_gbs))) goto done;
-        printf("%-28s %14.3f %11.2f GB/s\n", "STREAM triad (same size)", 1e3 * ts, stream_gbs);
-        if ((status = triad(&bc, (size_t)16 << 20, min_s, &ts, &stream_dram_gbs))) goto done;
-        printf("%-28s %14.3f %11.2f GB/s\n", "STREAM triad (384 MB)", 1e3 * ts, stream_dram_gbs);
-        double tm = best_time(run_hessvec, &bc, min_s);
+        printf("%-28s %10.3f ms %11.2f GB/s\n", "block-CSR SpMV", 1e3 * t, spmv_gbs);
+        /* STREAM triad over a working set of the same size */
+        if ((status = machine_stream_triad((size_t)(bytes / 24.0), min_s, &ts, &stream_gbs))) goto done;
+        printf("%-28s %10.3f ms %11.2f GB/s\n", "STREAM triad (same size)", 1e3 * ts, stream_gbs);
+        double tm = machine_best_time(run_hessvec, &bc, min_s, NULL);
         mf_gbs_equiv = bytes / tm / 1e9;
-        printf("%-28s %14.3f %11.2fx SpMV time\n", "matrix-free H x", 1e3 * tm, tm / t);
+        printf("%-28s %10.3f ms %11.2fx SpMV time\n", "matrix-free H x", 1e3 * tm, tm / t);
+        printf("spmv_gbs=%.3f\nstream_gbs=%.3f\nspmv_stream_ratio=%.3f\nstream_dram_gbs=%.3f\n"
+               "spmv_stream_dram_ratio=%.3f\nhessvec_over_spmv_time=%.3f\n",
+               spmv_gbs, stream_gbs, spmv_gbs / stream_gbs, L.stream_gbs, spmv_gbs / L.stream_gbs,
+               spmv_gbs / mf_gbs_equiv);
+    }
+    if (all || !strcmp(what, "hessvec")) {
+        double t = machine_best_time(run_hessvec, &bc, min_s, &spread);
+        report(&L, model_hessvec(npp), t, spread, "hessvec");
     }
     if (all || !strcmp(what, "assemble")) {
-        double t = best_time(run_assemble, &bc, min_s);
-        asm_pps = np / t;
-        printf("%-28s %14.3f %11.3g p/s\n", "assemble (dP/dF + scatter)", 1e3 * t, asm_pps);
-        double t2 = best_time(run_scatter, &bc, min_s);
-        scatter_pps = np / t2;
-        printf("%-28s %14.3f %11.3g p/s\n", "assemble (scatter only)", 1e3 * t2, scatter_pps);
+        double t = machine_best_time(run_assemble, &bc, min_s, &spread);
+        report(&L, model_assemble((double)H.nnzb / (double)np), t, spread, "assemble");
+        double t2 = machine_best_time(run_scatter, &bc, min_s, NULL);
+        printf("%-28s %10.3f ms %10.3g p/s\nscatter_particles_per_s=%.4g\n", "assemble (scatter only)", 1e3 * t2,
+               np / t2, np / t2);
     }
     if (all || !strcmp(what, "p2g")) {
-        double t = best_time(run_p2g, &bc, min_s);
-        p2g_pps = np / t;
-        printf("%-28s %14.3f %11.3g p/s\n", "P2G (APIC)", 1e3 * t, p2g_pps);
+        double t = machine_best_time(run_p2g, &bc, min_s, &spread);
+        report(&L, model_p2g(scene.transfer == TRANSFER_MLS, npp), t, spread, "p2g");
+    }
+    if (all || !strcmp(what, "g2p")) {
+        double t = machine_best_time(run_g2p, &bc, min_s, &spread);
+        report(&L, model_g2p(scene.transfer == TRANSFER_MLS, npp), t, spread, "g2p");
     }
     printf("particles=%zu\nactive_nodes=%d\nhessian_blocks=%lld\nhessian_bytes_per_node=%.1f\n", np, n,
            (long long)H.nnzb, (double)mat_bytes / n);
-    if (spmv_gbs > 0) {
-        printf("spmv_gbs=%.3f\nstream_gbs=%.3f\nspmv_stream_ratio=%.3f\nstream_dram_gbs=%.3f\n"
-               "spmv_stream_dram_ratio=%.3f\nhessvec_over_spmv_time=%.3f\n",
-               spmv_gbs, stream_gbs, spmv_gbs / stream_gbs, stream_dram_gbs, spmv_gbs / stream_dram_gbs,
-               spmv_gbs / mf_gbs_equiv);
-    }
-    if (asm_pps > 0) printf("assemble_particles_per_s=%.4g\nscatter_particles_per_s=%.4g\n", asm_pps, scatter_pps);
-    if (p2g_pps > 0) printf("p2g_particles_per_s=%.4g\n", p2g_pps);
-    printf("threads=%d\n", threads);
+    printf("transfer=%s\nstream_dram_gbs=%.3f\npeak_gflops=%.3f\npeak_isa=%s\nbuild_peak_gflops=%.3f\nthreads=%d\n",
+           tname, L.stream_gbs, L.peak_machine, peak.isa, L.peak_build, threads);
 done:
     free(bc.x);
     free(bc.y);
+    free(bc.vnew);
     bsr_free(&H);
     sim_free(&sim);
     scene_free(&scene);

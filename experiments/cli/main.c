@@ -25,7 +25,8 @@ static void usage(FILE *f)
             "               [--max-outer N] [--max-linear N] [--max-step-seconds S] [--max-run-seconds S]\n"
             "               [--on-failure stop|continue] [--error-ref SOLVER[:eps]|auto[:eps]] [--trajectory]\n"
             "               [--dt-from RUN_DIR] [--trajectory-ref RUN_DIR]\n"
-            "  mpmbench bench spmv|assemble|p2g|all --scene NAME [--scale S] [--threads T] [--set key=value ...]\n"
+            "  mpmbench bench spmv|assemble|hessvec|p2g|g2p|all --scene NAME [--transfer apic|mls] [--scale S] [--threads T]\n"
+            "               [--set key=value ...]\n"
             "  mpmbench render --scene NAME|FILE [--frame N] [--out FILE.png] [--solver NAME] [--scale S] [--set key=value ...]\n"
             "               [--view front|side|top|iso] [--color material|speed] [--width W] [--height H] [--asset-dir DIR] [--threads T]\n"
             "  mpmbench matrix run FILE [--out DIR] [--only GLOB ...] [--dry-run] [--jobs N] [--threads T] [--asset-dir DIR]\n"
@@ -175,12 +176,34 @@ static int cmd_run(int argc, char **argv)
 static int cmd_bench(int argc, char **argv)
 {
     static Args a;
+    static const char *const targets[] = {"spmv", "assemble", "hessvec", "p2g", "g2p", "all", NULL};
     run_config_default(&a.run);
-    if (argc < 3) return mpm_error(MPM_EINPUT, "bench: expected spmv, assemble, p2g or all");
+    if (argc < 3) return mpm_error(MPM_EINPUT, "bench: expected spmv, assemble, hessvec, p2g, g2p or all");
     const char *what = argv[2];
-    if (strcmp(what, "spmv") && strcmp(what, "assemble") && strcmp(what, "p2g") && strcmp(what, "all"))
-        return mpm_error(MPM_EINPUT, "bench '%s': expected spmv, assemble, p2g or all", what);
-    int st = parse_args(argc, argv, 3, &a);
+    int known = 0;
+    for (int k = 0; targets[k]; ++k) known |= !strcmp(what, targets[k]);
+    if (!known) return mpm_error(MPM_EINPUT, "bench '%s': expected spmv, assemble, hessvec, p2g, g2p or all", what);
+    /* --transfer apic|mls is --set transfer=...; the rest are run's options */
+    static char *rest[512];
+    static char transfer_set[64];
+    int nrest = 0;
+    const char *transfer = NULL;
+    for (int i = 3; i < argc && nrest < 510; ++i) {
+        if (!strcmp(argv[i], "--transfer")) {
+            if (i + 1 >= argc) return mpm_error(MPM_EINPUT, "--transfer: missing value");
+            transfer = argv[++i];
+            if (strcmp(transfer, "apic") && strcmp(transfer, "mls"))
+                return mpm_error(MPM_EINPUT, "--transfer '%s': expected apic or mls", transfer);
+        } else {
+            rest[nrest++] = argv[i];
+        }
+    }
+    if (transfer) {
+        snprintf(transfer_set, sizeof transfer_set, "transfer=%s", transfer);
+        rest[nrest++] = "--set";
+        rest[nrest++] = transfer_set;
+    }
+    int st = parse_args(nrest, rest, 0, &a);
     if (st) return st;
     if (!a.run.scene) return mpm_error(MPM_EINPUT, "bench: --scene is required");
     return bench_run(what, &a.run);

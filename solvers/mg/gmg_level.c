@@ -53,6 +53,7 @@ int gmg_level_build(GmgLevel *L, const StepProblem *fine, double h, Bsr *A)
         p->mat[k] = fp->mat[s];
     }
     if ((st = grid_build(&L->grid, &L->st, p, h)) == MPM_OK) {
+        if (fine->st->mls) stencils_use_mls_gradients(&L->st, p, h); /* rediscretise as the fine level */
         transfer_p2g(&L->grid, &L->st, p);
         st = problem_prepare(&L->pb, &L->grid, &L->st, p, fine->mats, fine->n_mats, fine->dt, fine->gravity);
     }

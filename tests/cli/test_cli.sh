@@ -62,11 +62,19 @@ fi
 # bench: a table, then one key=value line per figure, all positive
 "$bin" bench all --scene drop --threads 2 >"$tmp/bench.out" 2>&1
 check "bench exit 0" test $? -eq 0
-for key in spmv_gbs stream_gbs spmv_stream_ratio assemble_particles_per_s p2g_particles_per_s threads; do
+for key in spmv_gbs stream_gbs spmv_stream_ratio assemble_particles_per_s p2g_particles_per_s threads \
+  g2p_particles_per_s hessvec_particles_per_s p2g_stream_fraction p2g_peak_fraction g2p_flops_per_particle \
+  stream_dram_gbs peak_gflops; do
   check "bench reports $key > 0" awk -F= -v k="$key" '$1 == k && $2 + 0 > 0 {found = 1} END {exit !found}' "$tmp/bench.out"
 done
 check "bench: particles of drop" grep -qx "particles=6938" "$tmp/bench.out"
 expect_input_error "bench.*frobnicate|unknown" bench frobnicate --scene drop
+# --transfer mls is --set transfer=mls; the MLS kernels report the same figures
+"$bin" bench p2g --scene drop --threads 1 --transfer mls >"$tmp/bench-mls.out" 2>&1
+check "bench --transfer mls exit 0" test $? -eq 0
+check "bench --transfer mls: transfer=mls" grep -qx "transfer=mls" "$tmp/bench-mls.out"
+check "bench --transfer mls: fused P2G" grep -q "MLS fused" "$tmp/bench-mls.out"
+expect_input_error "transfer.*pic" bench p2g --scene drop --transfer pic
 
 # run.json records every option the solver consulted with the value in effect
 "$bin" run --scene stretched-box --scale 3.6 --solver hot --solver-opt embedding=quadratic --frames 1 --quiet \

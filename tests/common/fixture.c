@@ -56,7 +56,12 @@ int fixture_build(Fixture *f, const FixtureOptions *o)
             }
     int st = grid_build(&f->g, &f->st, &f->p, o->dx);
     if (st) return st;
-    transfer_p2g(&f->g, &f->st, &f->p);
+    if (o->mls) {
+        stencils_use_mls_gradients(&f->st, &f->p, o->dx);
+        transfer_p2g_mls(&f->g, &f->st, &f->p, NULL);
+    } else {
+        transfer_p2g(&f->g, &f->st, &f->p);
+    }
     return problem_prepare(&f->pb, &f->g, &f->st, &f->p, f->mats, 2, o->dt, o->gravity);
 }
 

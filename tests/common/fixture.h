@@ -29,6 +29,7 @@ typedef struct {
     double dt;
     double gravity[3];
     unsigned long long seed;
+    int mls;             /* 1: MLS-MPM gradients (stencils_use_mls_gradients) and the fused P2G */
 } FixtureOptions;
 
 /* The first step problem of a built-in scene (or scene file) at --scale,

@@ -4,7 +4,7 @@
  * where K_c is assembled directly on the coarse grid from the *composed*
  * weight gradients a~_Jp = sum_i P_iJ a_ip (a_ip = F^nT grad w_ip), with the
  * same per-particle tangent A_p. Checked for the linear and quadratic
- * embeddings, to round-off. Also: the coarse operators are symmetric PSD. */
+ * embeddings, to round-off, with B-spline and MLS-MPM gradients. Also: the coarse operators are symmetric PSD. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,10 +16,11 @@
 #include "tests/common/fixture.h"
 #include "tests/common/testutil.h"
 
-static void check_embedding(MgEmbedding kind, const char *name)
+static void check_embedding(MgEmbedding kind, const char *name, int mls)
 {
     FixtureOptions o;
     fixture_default(&o);
+    o.mls = mls;
     o.per_axis = 6;
     o.two_materials = 1;
     o.F_noise = 0.3;
@@ -120,7 +121,10 @@ static void check_embedding(MgEmbedding kind, const char *name)
 
 int main(void)
 {
-    check_embedding(MG_EMBED_LINEAR, "linear");
-    check_embedding(MG_EMBED_QUADRATIC, "quadratic");
+    check_embedding(MG_EMBED_LINEAR, "linear", 0);
+    check_embedding(MG_EMBED_QUADRATIC, "quadratic", 0);
+    /* the MLS Hessian (SPEC 9): a_ip from the MLS gradient substitute */
+    check_embedding(MG_EMBED_LINEAR, "linear/mls", 1);
+    check_embedding(MG_EMBED_QUADRATIC, "quadratic/mls", 1);
     return test_summary("test_galerkin");
 }

@@ -5,6 +5,7 @@
  *  - assembled == matrix-free to 1e-12 relative, with and without Dirichlet nodes;
  *  - the assembled projected Hessian is symmetric positive semidefinite
  *    (GSL eigenvalues) on random, inverted and near-degenerate F;
+ *  - each of the above with the MLS-MPM gradient substitute (SPEC 9);
  *  - CN: for one material the scaled residual equals the plain L2 norm times
  *    a constant scale. */
 #include <gsl/gsl_eigen.h>
@@ -23,10 +24,11 @@ static void random_vec(int n, double *v, unsigned long long *rs, double scale)
     for (int i = 0; i < 3 * n; ++i) v[i] = scale * test_uniform(rs, -1, 1);
 }
 
-static void test_gradient_fd(void)
+static void test_gradient_fd(int mls)
 {
     FixtureOptions o;
     fixture_default(&o);
+    o.mls = mls;
     o.two_materials = 1;
     o.gravity[1] = -9.8;
     Fixture f;
@@ -45,7 +47,7 @@ static void test_gradient_fd(void)
     for (int i = 0; i < 3 * n; ++i) tmp[i] = dv[i] - h * d[i];
     double Em = problem_energy(&f.pb, tmp);
     double fd = (Ep - Em) / (2 * h);
-    CHECK(rel_diff(fd, gd, 1e-12) < 1e-6, "directional derivative fd %.12e vs g.d %.12e", fd, gd);
+    CHECK(rel_diff(fd, gd, 1e-12) < 1e-6, "mls=%d: directional derivative fd %.12e vs g.d %.12e", mls, fd, gd);
     /* per-component check on a few entries */
     for (int k = 0; k < 20; ++k) {
         int idx = (int)test_uniform(&rs, 0, 3 * n);
@@ -56,16 +58,17 @@ static void test_gradient_fd(void)
         double b = problem_energy(&f.pb, tmp);
         double fdk = (a - b) / (2 * h);
         CHECK(fabs(fdk - g[idx]) < 1e-6 * (fabs(g[idx]) + vec_norm(3 * (size_t)n, g) / sqrt(3.0 * n)),
-              "dE/ddv[%d]: fd %.10e vs %.10e", idx, fdk, g[idx]);
+              "mls=%d: dE/ddv[%d]: fd %.10e vs %.10e", mls, idx, fdk, g[idx]);
     }
     free(dv), free(g), free(d), free(tmp);
     fixture_free(&f);
 }
 
-static void test_hessian_fd(void)
+static void test_hessian_fd(int mls)
 {
     FixtureOptions o;
     fixture_default(&o);
+    o.mls = mls;
     o.two_materials = 1;
     Fixture f;
     CHECK(fixture_build(&f, &o) == 0, "fixture");
@@ -96,8 +99,9 @@ static void test_hessian_fd(void)
         err_mf += (fd - Hd_mf[i]) * (fd - Hd_mf[i]);
         nrm += Hd[i] * Hd[i];
     }
-    CHECK(sqrt(err / nrm) < 1e-6, "assembled H d vs gradient differences: rel err %.3e", sqrt(err / nrm));
-    CHECK(sqrt(err_mf / nrm) < 1e-6, "matrix-free H d vs gradient differences: rel err %.3e", sqrt(err_mf / nrm));
+    CHECK(sqrt(err / nrm) < 1e-6, "mls=%d: assembled H d vs gradient differences: rel err %.3e", mls, sqrt(err / nrm));
+    CHECK(sqrt(err_mf / nrm) < 1e-6, "mls=%d: matrix-free H d vs gradient differences: rel err %.3e", mls,
+          sqrt(err_mf / nrm));
     bsr_free(&H);
     free(dv), free(d), free(gp), free(gm), free(tmp), free(Hd), free(Hd_mf);
     fixture_free(&f);
@@ -116,10 +120,11 @@ static void mark_some_dirichlet(StepProblem *pb)
     problem_finish_dirichlet(pb);
 }
 
-static void test_assembled_equals_matrix_free(int with_bc)
+static void test_assembled_equals_matrix_free(int with_bc, int mls)
 {
     FixtureOptions o;
     fixture_default(&o);
+    o.mls = mls;
     o.two_materials = 1;
     o.per_axis = 8;
     o.F_noise = 0.3;
@@ -144,7 +149,8 @@ static void test_assembled_equals_matrix_free(int with_bc)
         err += (y1[i] - y2[i]) * (y1[i] - y2[i]);
         nrm += y1[i] * y1[i];
     }
-    CHECK(sqrt(err / nrm) < 1e-12, "assembled vs matrix-free (bc=%d): rel diff %.3e", with_bc, sqrt(err / nrm));
+    CHECK(sqrt(err / nrm) < 1e-12, "assembled vs matrix-free (bc=%d, mls=%d): rel diff %.3e", with_bc, mls,
+          sqrt(err / nrm));
     /* diagonal blocks agree too */
     double *D1 = calloc(9 * (size_t)n, sizeof(double)), *D2 = calloc(9 * (size_t)n, sizeof(double));
     bsr_diagonal(&H, D1);
@@ -179,10 +185,11 @@ static void test_assembled_equals_matrix_free(int with_bc)
     fixture_free(&f);
 }
 
-static void test_projected_hessian_spd(int inverted_pct, double F_noise, const char *what)
+static void test_projected_hessian_spd(int inverted_pct, double F_noise, const char *what, int mls)
 {
     FixtureOptions o;
     fixture_default(&o);
+    o.mls = mls;
     o.per_axis = 4;
     o.two_materials = 1;
     o.F_noise = F_noise;
@@ -265,13 +272,15 @@ static void test_cn_single_material(void)
 
 int main(void)
 {
-    test_gradient_fd();
-    test_hessian_fd();
-    test_assembled_equals_matrix_free(0);
-    test_assembled_equals_matrix_free(1);
-    test_projected_hessian_spd(0, 0.4, "random");
-    test_projected_hessian_spd(50, 0.3, "inverted");
-    test_projected_hessian_spd(0, 0.0, "near-degenerate");
+    for (int mls = 0; mls <= 1; ++mls) { /* B-spline gradients, then the MLS substitute (SPEC 9) */
+        test_gradient_fd(mls);
+        test_hessian_fd(mls);
+        test_assembled_equals_matrix_free(0, mls);
+        test_assembled_equals_matrix_free(1, mls);
+        test_projected_hessian_spd(0, 0.4, "random", mls);
+        test_projected_hessian_spd(50, 0.3, "inverted", mls);
+        test_projected_hessian_spd(0, 0.0, "near-degenerate", mls);
+    }
     test_cn_single_material();
     return test_summary("test_problem");
 }
