@@ -10,8 +10,10 @@ whose frames.csv has pos_rms (run against a reference run):
     reference solves: they are ref_s);
   * a work-precision case is a case without its eps: one line per solver
     through its cells in eps order (cells that did not end ok are left out);
-  * figures/wp_NN_CASE.png: wall time against median err_h and against the
-    last frame's pos_rms, log-log, one line per solver;
+  * figures/wp_NN_CASE.png: wall time against median err_h (each point
+    labelled by its eps, the targets as labelled lines) and, when the matrix
+    has reference runs, against the last frame's pos_rms (without them the
+    panel is left out and the report says why), log-log, one line per solver;
   * "time to reach err_h <= 1e-2 / 1e-3 / 1e-4 / 1e-6": along the solver's eps sequence
     (loosest first), the first cell whose median err_h is at or below the
     target, the time interpolated linearly in log(err_h)-log(time) between
@@ -25,7 +27,10 @@ whose frames.csv has pos_rms (run against a reference run):
 
 Robustness, when DIR/check.csv exists (`matrix run --check`): a case x solver
 grid of pass / FAIL, the share of cases each solver passed, the reasons of
-every failing cell, and figures/robustness.png.
+every failing cell, and figures/robustness.png, the grid as a table with the
+status word in each cell.
+
+Both return a line for the report's answer.
 """
 import csv
 import math
@@ -123,18 +128,15 @@ def _profile(plt, root, problems, order, md, helpers):
     fig, ax = helpers["profile_figure"](plt, ratios, order)
     if fig is None:
         return
-    ax.set_xlabel("tau (time to the target err_h within a factor tau of the best)")
-    ax.set_ylabel("fraction of (case, target) problems")
-    ax.set_title(f"Performance profile at matched accuracy ({len(problems)} problems: err_h <= "
-                 + ", ".join(f"{t:g}" for t in TARGETS) + ")", fontsize=9)
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8, loc="lower right")
+    ax.set_xlabel("tau (time to the target within tau x the best)")
+    ax.set_ylabel("share of problems")
+    ax.set_title(f"At matched accuracy, {len(problems)} problems")
     path = helpers["save"](fig, root, "profile_accuracy.png")
     plt.close(fig)
-    md.append("\n### Performance profile at matched accuracy\n")
-    md.append("Each (case, target err_h) is a problem; a solver's cost is its time to reach the target "
-              "(not reached: never within any factor).\n")
     md.append(f"![performance profile at matched accuracy]({path})\n")
+    md.append("Performance profile at matched accuracy: each (case, target err_h <= "
+              + ", ".join(f"{t:g}" for t in TARGETS) + ") is a problem; a solver's cost is its time to reach the "
+              "target (not reached: never within any factor).\n")
 
 
 def _per_eps_table(lines, eps_values, value, fmt, markdown):
@@ -146,11 +148,13 @@ def _per_eps_table(lines, eps_values, value, fmt, markdown):
     return markdown(["solver"] + [f"eps {e:g}" for e in eps_values], rows)
 
 
-def work_precision(plt, root, cells, cols, order, md, helpers):
-    """The work-precision section (see the module's docstring)."""
+def work_precision(plt, root, cells, cols, order, md_fig, md, helpers):
+    """The work-precision section (see the module's docstring): per-case tables and figures into
+    md (the detail), the profile at matched accuracy into md_fig; returns the answer line."""
     fmt, markdown, slug, save, new_figure, case_title, varying = (
         helpers["fmt"], helpers["markdown"], helpers["slug"], helpers["save"], helpers["new_figure"],
         helpers["case_title"], helpers["varying"])
+    style, value_key = helpers["style"], helpers["value_key"]
     for c in cells:
         cell_accuracy(c)
     acc = [c for c in cells if c.has_accuracy]
@@ -160,14 +164,19 @@ def work_precision(plt, root, cells, cols, order, md, helpers):
     groups = {}
     for c in acc:
         groups.setdefault(tuple(c.row.get(k, "") for k in rest), []).append(c)
+    groups = dict(sorted(groups.items(), key=lambda kv: tuple(value_key(v) for v in kv[0])))
     show = varying(acc, rest)
-    md.append("\n## Work precision\n")
+    has_trajectory = any(math.isfinite(c.pos_rms) for c in acc)
+    md.append("\n### Work precision\n")
     md.append("Per-step error err_h = ||dv - dv*||_H / ||dv* - dv0||_H against the reference solve of the same "
               "step problem (median over the timed steps), the last frame's particle position error pos_rms (in "
               "dx) against the reference run, and the timed wall time, which excludes the reference solves "
               "(their time is ref_s). Cells that did not end ok are left out.\n")
     wp_rows, problems = [], {}
-    for i, (key, cs) in enumerate(sorted(groups.items())):
+    if not has_trajectory:
+        md.append("(No trajectory panel in the figures: the matrix has no reference run, so pos_rms was not "
+                  "measured.)\n")
+    for i, (key, cs) in enumerate(groups.items()):
         title = case_title(key, rest, show)
         lines = {}
         for s in order:
@@ -179,7 +188,7 @@ def work_precision(plt, root, cells, cols, order, md, helpers):
                             c.err_v_max, c.pos_rms, c.pos_max, c.vel_rms])
         if not lines:
             continue
-        md.append(f"### {title}\n")
+        md.append(f"#### {title}\n")
         eps_values = sorted({_num(c.row.get("eps")) for c in cs}, reverse=True)
         md.append("Median err_h per eps:\n")
         md.append(_per_eps_table(lines, eps_values, lambda c: c.err_h, fmt, markdown))
@@ -196,31 +205,42 @@ def work_precision(plt, root, cells, cols, order, md, helpers):
             rows.append(line)
         md.append("\nWall seconds (timed window) to reach a median err_h, interpolated in log-log along eps:\n")
         md.append(markdown(["solver"] + [f"err_h <= {t:g}" for t in TARGETS], rows))
-        fig, (a1, a2) = new_figure(plt, 2)
+        panels = 2 if has_trajectory else 1
+        n_lab = len(lines)
+        width = (style.TWO_COLUMNS if panels == 2 else style.ONE_COLUMN)[0]
+        fig, axes = new_figure(plt, panels, height=(style.TWO_COLUMNS[1] if panels == 2 else 2.9)
+                               + helpers["legend_height"](n_lab, width))
+        axes = list(axes) if panels == 2 else [axes]
+        a1 = axes[0]
+        names = list(lines)
+        labels = []
         for s, pts in lines.items():
-            e = [(c.err_h, c.timed_wall) for c in pts if math.isfinite(c.err_h) and c.err_h > 0]
-            p = [(c.pos_rms, c.timed_wall) for c in pts if math.isfinite(c.pos_rms) and c.pos_rms > 0]
+            kw = style.line_kwargs(s, names, ms=3.5)
+            e = [(c.err_h, c.timed_wall, c) for c in pts if math.isfinite(c.err_h) and c.err_h > 0]
             if e:
-                a1.plot([x for x, _ in e], [y for _, y in e], marker="o", ms=3, label=s)
-            if p:
-                a2.plot([x for x, _ in p], [y for _, y in p], marker="o", ms=3, label=s)
-        for a, lab in ((a1, "median err_h per step"), (a2, "pos_rms at the last frame [dx]")):
+                a1.plot([x for x, _, _ in e], [y for _, y, _ in e], **kw)
+                labels.append((kw["color"], e))
+            if panels == 2:
+                p = [(c.pos_rms, c.timed_wall) for c in pts if math.isfinite(c.pos_rms) and c.pos_rms > 0]
+                if p:
+                    axes[1].plot([x for x, _ in p], [y for _, y in p], **kw)
+        labs = ["median err_h per step", "pos_rms at the last frame [dx]"]
+        for a, lab in zip(axes, labs):
             a.set_xscale("log")
             a.set_yscale("log")
             a.set_xlabel(lab)
             a.set_ylabel("wall seconds (timed window)")
-            a.grid(True, alpha=0.3, which="both")
         if a1.lines:
             for target in TARGETS:
-                a1.axvline(target, ls="--", color="0.6", lw=0.8)
-            a1.legend(fontsize=7)
-        elif a2.lines:
-            a2.legend(fontsize=7)
-        for a in (a1, a2):
+                a1.axvline(target, ls="--", color="0.6", lw=0.7)
+                a1.annotate(f"{target:.0e}".replace("e-0", "e-"), xy=(target, 1.0), xycoords=("data", "axes fraction"),
+                            ha="center", va="bottom", fontsize=style.FONT_PT - 2, color="0.4")
+            _label_eps(fig, a1, labels, style.FONT_PT - 2.5)
+        for a in axes:
             if not a.lines:
                 a.text(0.5, 0.5, "no positive errors", ha="center", va="center", transform=a.transAxes)
-        fig.suptitle(f"Work precision: {title}", fontsize=10)
-        fig.tight_layout()
+        helpers["legend_outside"](fig, a1)
+        fig.suptitle(f"Work precision: {title}", fontsize=style.FONT_PT + 1)
         path = save(fig, root, f"wp_{i:02d}_{slug(title)}.png")
         plt.close(fig)
         md.append(f"\n![work precision, {title}]({path})\n")
@@ -232,61 +252,125 @@ def work_precision(plt, root, cells, cols, order, md, helpers):
             w.writerow([f"{x:.9g}" if isinstance(x, float) and math.isfinite(x) else
                         "" if isinstance(x, float) else x for x in r])
     if problems:
-        _profile(plt, root, problems, order, md, helpers)
+        _profile(plt, root, problems, order, md_fig, helpers)
+    return _wp_answer(problems, fmt)
 
 
-def robustness(plt, root, md, order, helpers):
-    """The pass/fail grid of DIR/check.csv (matrix run --check)."""
+def _label_eps(fig, ax, lines, size):
+    """Each point labelled by its eps, in the line's colour, leaving out a label that would
+    overlap one already placed (points nearer than about one label in display space)."""
+    fig.canvas.draw()  # the final limits, so data map to display coordinates
+    placed = []
+    for colour, pts in lines:
+        for x, y, c in pts:
+            px, py = ax.transData.transform((x, y))
+            if any(abs(px - qx) < 26 and abs(py - qy) < 9 for qx, qy in placed):
+                continue
+            placed.append((px, py))
+            ax.annotate(f"{_num(c.row.get('eps')):.0e}".replace("e-0", "e-"), (x, y), textcoords="offset points",
+                        xytext=(3, 2), fontsize=size, color=colour)
+
+
+def _wp_answer(problems, fmt):
+    """'Accuracy: fastest to err_h <= T: S (k of n cases)' for every target some solver reached."""
+    parts = []
+    for target in TARGETS:
+        wins, n = {}, 0
+        for (case, t), times in problems.items():
+            if t != target:
+                continue
+            finite = {s: x for s, x in times.items() if math.isfinite(x)}
+            if not finite:
+                continue
+            n += 1
+            best = min(finite, key=finite.get)
+            wins[best] = wins.get(best, 0) + 1
+        if n:
+            top = sorted(wins.items(), key=lambda kv: -kv[1])
+            parts.append(f"err_h <= {target:g}: {top[0][0]} ({top[0][1]} of {n} cases)")
+    if not parts:
+        return None
+    return "Accuracy, fastest to reach a median per-step error: " + "; ".join(parts) + "."
+
+
+def robustness(plt, root, md_fig, md, order, helpers):
+    """The pass/fail grid of DIR/check.csv (matrix run --check): the table into md (the detail),
+    the grid figure into md_fig; returns ({solver: (passed, total)}, answer line) or (None, None)."""
     rows = _read(os.path.join(root, "check.csv"))
     if not rows:
-        return
-    markdown, save, new_figure = helpers["markdown"], helpers["save"], helpers["new_figure"]
+        return None, None
+    markdown, save, style = helpers["markdown"], helpers["save"], helpers["style"]
     fixed = {"id", "solver", "pass", "reasons"}
     keys = [k for k in rows[0] if k not in fixed]
     keys = [k for k in keys if k == "scene" or len({r.get(k, "") for r in rows}) > 1]
     grid, cases = {}, []
+    def case_of(r):
+        # a named axis whose value already names the scene ("case": "bar3 E_mid=1e4") is shown alone
+        parts = [f"{k}={r[k]}" if not r[k].startswith(r.get("scene", "") + " ") else r[k]
+                 for k in keys if k != "scene"]
+        if any(not p.startswith(f"{k}=") for p, k in zip(parts, [k for k in keys if k != "scene"])):
+            return " ".join(parts)
+        return " ".join([r.get("scene", "")] + parts)
+
     for r in rows:
-        case = " ".join([r.get("scene", "")] + [f"{k}={r[k]}" for k in keys if k != "scene"])
+        case = case_of(r)
         if case not in cases:
             cases.append(case)
         grid[(case, r["solver"])] = r
     solvers = [s for s in order if any((c, s) in grid for c in cases)]
     solvers += sorted({r["solver"] for r in rows} - set(solvers))
-    md.append("\n## Robustness (matrix run --check)\n")
+    md.append("\n### Robustness (matrix run --check)\n")
     md.append("Pass: every step converged (residual re-checked) or reported capped / stalled / timeout / failed, no "
               "NaN or Inf in the outputs, no line search accepted an energy increase, the run ended inside its "
               "wall-clock limit and particles stayed in the domain or the run said otherwise "
               "(experiments/matrix/matrix_check.h).\n")
-    table = []
+    word = {}
     for case in cases:
-        line = [case]
         for s in solvers:
             r = grid.get((case, s))
-            line.append("-" if r is None else "pass" if r["pass"] == "1" else "**FAIL**")
-        table.append(line)
-    passed = [sum(1 for c in cases if grid.get((c, s), {}).get("pass") == "1") for s in solvers]
-    total = [sum(1 for c in cases if (c, s) in grid) for s in solvers]
-    table.append(["**passed**"] + [f"{p}/{t}" for p, t in zip(passed, total)])
+            word[(case, s)] = "-" if r is None else "pass" if r["pass"] == "1" else "FAIL"
+    table = [[case] + [{"FAIL": "**FAIL**"}.get(word[(case, s)], word[(case, s)]) for s in solvers] for case in cases]
+    passed = {s: (sum(1 for c in cases if word[(c, s)] == "pass"), sum(1 for c in cases if (c, s) in grid))
+              for s in solvers}
+    table.append(["**passed**"] + [f"{passed[s][0]}/{passed[s][1]}" for s in solvers])
     md.append(markdown(["case"] + solvers, table))
     fails = [r for r in rows if r["pass"] != "1"]
     if fails:
         md.append("\nFailing cells:\n")
         for r in fails:
-            case = " ".join([r.get("scene", "")] + [f"{k}={r[k]}" for k in keys if k != "scene"])
+            case = case_of(r)
             md.append(f"- {case} / {r['solver']} ({r['id']}): {r['reasons']}")
         md.append("")
-    fig, ax = new_figure(plt)
-    import matplotlib.colors as mcolors
-    values = [[(1.0 if grid[(c, s)]["pass"] == "1" else 0.0) if (c, s) in grid else float("nan") for s in solvers]
-              for c in cases]
-    ax.imshow(values, aspect="auto", cmap=mcolors.ListedColormap(["#d62728", "#2ca02c"]), vmin=0, vmax=1,
-              interpolation="nearest")
-    ax.set_xticks(range(len(solvers)))
-    ax.set_xticklabels(solvers, rotation=30, ha="right", fontsize=7)
-    ax.set_yticks(range(len(cases)))
-    ax.set_yticklabels(cases, fontsize=max(4, min(8, int(300 / max(1, len(cases))))))
-    ax.set_title(f"Robustness: {sum(passed)} of {sum(total)} cells pass (green)", fontsize=10)
-    fig.tight_layout()
+    # the grid as a table-figure: one row per case, the status word in each cell
+    width = min(7.1, 1.6 + 0.62 * len(solvers))
+    fig, ax = plt.subplots(figsize=(width, 0.55 + 0.16 * (len(cases) + 1)))
+    for i, case in enumerate(cases):
+        for j, s in enumerate(solvers):
+            w = word[(case, s)]
+            ax.add_patch(__import__("matplotlib").patches.Rectangle((j, i), 1, 1, facecolor=style.STATUS_FILL[w],
+                                                                     edgecolor="white", lw=0.8))
+            ax.text(j + 0.5, i + 0.5, w, ha="center", va="center", fontsize=style.FONT_PT - 2,
+                    fontweight="bold" if w == "FAIL" else "normal")
+    ax.set_xlim(0, len(solvers))
+    ax.set_ylim(len(cases), 0)
+    ax.set_xticks([j + 0.5 for j in range(len(solvers))])
+    ax.set_xticklabels(solvers, rotation=35, ha="left", fontsize=style.FONT_PT - 1.5)
+    ax.xaxis.tick_top()
+    ax.set_yticks([i + 0.5 for i in range(len(cases))])
+    ax.set_yticklabels(cases, fontsize=style.FONT_PT - 1.5)
+    ax.tick_params(length=0)
+    ax.grid(False)
+    for sp in ax.spines.values():
+        sp.set_visible(False)
+    total_p = sum(p for p, _ in passed.values())
+    total = sum(t for _, t in passed.values())
     path = save(fig, root, "robustness.png")
     plt.close(fig)
-    md.append(f"\n![robustness grid]({path})\n")
+    md_fig.append(f"![robustness grid]({path})\n")
+    md_fig.append(f"Robustness (`matrix run --check`): {total_p} of {total} cells pass; one row per case, one column "
+                  "per solver.\n")
+    failing = sorted(((t - p, s) for s, (p, t) in passed.items() if p < t), reverse=True)
+    answer = f"Robustness: {total_p} of {total} cells pass `--check`"
+    answer += ("; every solver passes every case" if not failing else
+               "; failing: " + ", ".join(f"{s} {n} of {passed[s][1]}" for n, s in failing))
+    return passed, answer + "."

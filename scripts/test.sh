@@ -17,8 +17,10 @@ bash scripts/setup.sh
 
 # packages only testing needs: clang + its sanitizer runtime + libomp (the
 # fuzz build), valgrind (step 4), python3-jsonschema (tests/matrix/
-# test_matrix_schema.sh validates the matrix files against docs/matrix.schema.json)
-test_packages=(clang libclang-rt-14-dev libomp-dev valgrind python3-jsonschema)
+# test_matrix_schema.sh validates the matrix files against
+# docs/matrix.schema.json), python3-vtk9 (tests/cli/test_vtk.sh reads the
+# ParaView output back with VTK's reader)
+test_packages=(clang libclang-rt-14-dev libomp-dev valgrind python3-jsonschema python3-vtk9)
 missing=()
 for p in "${test_packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -21,7 +21,8 @@ static void usage(FILE *f)
             "  mpmbench list solvers|scenes\n"
             "  mpmbench run --scene NAME|FILE --solver NAME|OUTER:INVERSE[:key=value,...] [--frames N] [--eps E]\n"
             "               [--scale S] [--threads T] [--out DIR] [--set key=value ...] [--solver-opt key=value ...]\n"
-            "               [--history] [--particles DIR] [--asset-dir DIR] [--armijo] [--quiet] [--max-particles N]\n"
+            "               [--history] [--particles DIR] [--vtk DIR [--vtk-grid]] [--asset-dir DIR] [--armijo] [--quiet]\n"
+            "               [--max-particles N]\n"
             "               [--max-outer N] [--max-linear N] [--max-step-seconds S] [--max-run-seconds S]\n"
             "               [--on-failure stop|continue] [--error-ref SOLVER[:eps]|auto[:eps]] [--trajectory]\n"
             "               [--dt-from RUN_DIR] [--trajectory-ref RUN_DIR]\n"
@@ -125,6 +126,8 @@ static int parse_args(int argc, char **argv, int first, Args *a)
             if ((st = scene_parse_particle_budget(f, val, &c->max_particles))) return st;
         } else if (!strcmp(f, "--out")) { NEED_VAL(); c->out_dir = val; }
         else if (!strcmp(f, "--particles")) { NEED_VAL(); c->particles_dir = val; }
+        else if (!strcmp(f, "--vtk")) { NEED_VAL(); c->vtk_dir = val; }
+        else if (!strcmp(f, "--vtk-grid")) c->vtk_grid = 1;
         else if (!strcmp(f, "--error-ref")) { NEED_VAL(); c->error_ref = val; }
         else if (!strcmp(f, "--dt-from")) { NEED_VAL(); c->dt_from = val; }
         else if (!strcmp(f, "--trajectory-ref")) { NEED_VAL(); c->trajectory_ref = val; }

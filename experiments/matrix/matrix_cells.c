@@ -157,6 +157,10 @@ static int cell_identify(MatrixCell *c)
         text_key(&t, "reference", 0);
         text_string(&t, c->ref_id);
     }
+    if (c->repeat > 1) { /* the first run keeps the id of a matrix without repeat */
+        text_key(&t, "repeat", 0);
+        text_int(&t, c->repeat);
+    }
     text_key(&t, "scale", 0);
     text_number(&t, c->scale);
     text_key(&t, "scene", 0);
@@ -293,6 +297,7 @@ static int build_cell(const Matrix *m, const int *idx, MatrixCell *c)
     snprintf(c->asset_dir, sizeof c->asset_dir, "%s", d->has_asset_dir ? d->asset_dir : "");
     c->timeout_s = m->cell_timeout_s;
     c->ref = -1;
+    c->repeat = 1;
     run_settings(d, ps, c);
     if (idx[5] >= 0) snprintf(c->error_ref, sizeof c->error_ref, "%s", m->error_refs[idx[5]]);
     MatrixKvList set = d->set, opts = d->solver_opts;
@@ -385,6 +390,39 @@ static int prepend_references(MatrixCells *out, MatrixCell *refs, int n_refs)
     return MPM_OK;
 }
 
+/* Appends repetitions 2..n of every cell that is not a reference run. */
+static int add_repeats(MatrixCells *out, int n)
+{
+    if (n <= 1) return MPM_OK;
+    int base = out->n, per = 0;
+    for (int i = 0; i < base; ++i) per += !out->cells[i].is_reference;
+    MatrixCell *all = realloc(out->cells, sizeof *all * (size_t)(base + per * (n - 1) + 1));
+    if (!all) return mpm_error(MPM_EINTERNAL, "out of memory (%d cells x %d repeats)", per, n);
+    out->cells = all;
+    for (int k = 2; k <= n; ++k)
+        for (int i = 0; i < base; ++i) {
+            if (all[i].is_reference) continue;
+            MatrixCell *c = &all[out->n];
+            *c = all[i];
+            c->set = c->solver_opts = NULL;
+            c->canonical = NULL;
+            c->repeat = k;
+            MatrixKvList l = {.n = 0};
+            for (int j = 0; j < all[i].n_set; ++j) l.kv[l.n++] = all[i].set[j];
+            int st = copy_kv(&l, &c->set, &c->n_set);
+            l.n = 0;
+            for (int j = 0; j < all[i].n_solver_opts; ++j) l.kv[l.n++] = all[i].solver_opts[j];
+            if (!st) st = copy_kv(&l, &c->solver_opts, &c->n_solver_opts);
+            if (!st) st = cell_identify(c);
+            if (st) {
+                cell_release(c);
+                return st;
+            }
+            out->n++;
+        }
+    return MPM_OK;
+}
+
 int matrix_expand(const Matrix *m, MatrixCells *out)
 {
     memset(out, 0, sizeof *out);
@@ -439,9 +477,12 @@ int matrix_expand(const Matrix *m, MatrixCells *out)
             idx[a] = 0;
         }
     }
-    if (!st) st = prepend_references(out, refs, n_refs);
-    else
+    if (!st) {
+        st = prepend_references(out, refs, n_refs);
+        if (!st) st = add_repeats(out, m->repeat);
+    } else {
         for (int i = 0; i < n_refs; ++i) cell_release(&refs[i]);
+    }
     free(refs);
     return st;
 }
@@ -482,6 +523,7 @@ void matrix_cell_describe(const Matrix *m, const MatrixCell *c, char *out, size_
     if (c->error_ref[0] && len < n) len += (size_t)snprintf(out + len, n - len, " error_ref=%s", c->error_ref);
     for (int a = 0; a < m->n_named && len < n; ++a)
         len += (size_t)snprintf(out + len, n - len, " %s=%s", m->named[a].name, m->named[a].values[c->value[a]].label);
+    if (c->repeat > 1 && len < n) len += (size_t)snprintf(out + len, n - len, " repeat=%d", c->repeat);
     if (c->is_reference && len < n) len += (size_t)snprintf(out + len, n - len, " (reference run)");
     else if (c->ref_id[0] && len < n) len += (size_t)snprintf(out + len, n - len, " reference=%s", c->ref_id);
 }

@@ -39,6 +39,7 @@ typedef struct {
     int is_reference;            /* a reference run other cells depend on */
     int ref;                     /* index of this cell's reference cell, -1 = none */
     char ref_id[16];             /* its id ("" = none) */
+    int repeat;                  /* 1..matrix repeat: which run of the same settings */
 } MatrixCell;
 
 typedef struct {
@@ -49,7 +50,9 @@ typedef struct {
 /* Every cell of the matrix, in product order (scene slowest, then solver,
  * eps, scale, threads, error_ref, the named axes in file order), rules
  * applied, duplicates removed; the reference cells (matrix_file.h
- * "reference") first, in the order they are first needed. A dependent
+ * "reference") first, in the order they are first needed, and with
+ * "repeat": N > 1 the repetitions 2..N of every other cell after all of
+ * them (repetition by repetition, in the same order). A dependent
  * cell's canonical settings include its reference's id. MPM_EINPUT when a
  * cell's settings are inconsistent (a first timed frame not before its
  * frames). */

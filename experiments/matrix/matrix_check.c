@@ -176,6 +176,8 @@ void matrix_check_cell(const MatrixCell *c, const char *dir, const CsvTable *t, 
             first_line(path, NULL, line, sizeof line);
             fail(out, "exit %s: %s", exit_code, line[0] ? line : "(no message)");
         }
+    } else if (!strcmp(status, "time-limit")) { /* the run's own limit, which it reported */
+        snprintf(out->notes, sizeof out->notes, "reported: stopped at its max_run_seconds %g", c->max_run_s);
     } else if (strcmp(status, "ok") != 0) {
         fail(out, "status \"%s\"", status);
     }

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "core/error.h"
+#include "experiments/matrix/machine_load.h"
 
 extern char **environ;
 
@@ -68,6 +69,7 @@ int cell_child_start(char *const *args, int argc, const char *dir, double timeou
     else if (out < 0 || err < 0 || in < 0) st = mpm_error(MPM_EINTERNAL, "%s: cannot create the cell's output files", dir);
     pid_t parent = getpid();
     pid_t pid = -1;
+    double load0 = machine_load1(), busy0 = machine_busy_seconds();
     if (!st) {
         size_t k = 0;
         for (size_t i = 0; i < n_env; ++i)
@@ -101,6 +103,8 @@ int cell_child_start(char *const *args, int argc, const char *dir, double timeou
         c->pid = pid;
         c->t_start = matrix_now();
         c->timeout_s = timeout_s;
+        c->busy0 = busy0;
+        c->load0 = load0;
     }
     if (out >= 0) close(out);
     if (err >= 0) close(err);
@@ -125,7 +129,17 @@ int cell_child_poll(CellChild *c, CellOutcome *out)
     if (r == 0) return 0;
     if (r < 0 && errno == EINTR) return 0;
     if (r < 0) status = 0x7f00; /* lost (ECHILD): reported as a failed exit 127 */
+    double busy1 = machine_busy_seconds();
     *out = cell_outcome(status, c->timed_out, now - c->t_start, ru.ru_maxrss);
+    out->cpu_s = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_sec +
+                 1e-6 * (double)ru.ru_stime.tv_usec;
+    /* the machine's busy time is counted in clock ticks (10 ms): a tick or so
+     * of difference is no load */
+    if (busy1 >= 0 && c->busy0 >= 0) {
+        out->others_cpu_s = busy1 - c->busy0 - out->cpu_s;
+        if (out->others_cpu_s < 0) out->others_cpu_s = 0.0;
+    }
+    out->load_start = c->load0;
     c->pid = 0;
     return 1;
 }

@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "core/error.h"
 #include "experiments/matrix/matrix_child.h"
@@ -78,6 +79,9 @@ static int slot_poll(Slot *s, int rank, MatrixResult *r)
     r->rank = rank;
     r->outcome = o;
     cell_measure(s->task.dir, s->task.first_timed_frame, &r->measure);
+    if (r->outcome.status == CELL_OK && r->measure.cut_short) r->outcome.status = CELL_TIME_LIMIT;
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    r->outcome.busy = cell_busy(r->outcome.others_cpu_s, r->outcome.elapsed_s, r->measure.threads_run, (int)cores);
     s->busy = 0;
     return 1;
 }

@@ -615,8 +615,10 @@ static int get_rules(Matrix *m, json_t *rules, const char *path)
 static int get_top(Matrix *m)
 {
     static const char *const keys[] = {"name",     "description",    "defaults", "axes",      "scenes", "include",
-                                       "exclude",  "baseline",       "cell_timeout_s", "report", "reference", NULL};
+                                       "exclude",  "baseline",       "cell_timeout_s", "report", "reference", "repeat", NULL};
     json_t *root = m->root;
+    m->description = "";
+    m->repeat = 1;
     if (!json_is_object(root)) return bad_value(m, "(top level)", root, "an object");
     int st = check_keys(m, root, "", keys);
     if (st) return st;
@@ -628,7 +630,7 @@ static int get_top(Matrix *m)
             return bad_value(m, "name", v, "1-63 of A-Z a-z 0-9 _ - .");
     if ((v = json_object_get(root, "description"))) {
         if (!json_is_string(v)) return bad_value(m, "description", v, "a string");
-        snprintf(m->description, sizeof m->description, "%s", json_string_value(v));
+        m->description = json_string_value(v); /* any length: root keeps it */
     }
     if ((v = json_object_get(root, "defaults")) && (st = get_settings(m, v, "defaults", 0, &m->defaults))) return st;
     if ((v = json_object_get(root, "axes")) && (st = get_axes(m, v))) return st;
@@ -676,6 +678,11 @@ static int get_top(Matrix *m)
     }
     if ((v = json_object_get(root, "cell_timeout_s")) && (st = get_positive(m, v, "cell_timeout_s", &m->cell_timeout_s)))
         return st;
+    if ((v = json_object_get(root, "repeat"))) {
+        if (!json_is_integer(v) || json_integer_value(v) < 1 || json_integer_value(v) > 100)
+            return bad_value(m, "repeat", v, "an integer 1..100");
+        m->repeat = (int)json_integer_value(v);
+    }
     if ((v = json_object_get(root, "report"))) {
         static const char *const rk[] = {"mg_levels", NULL};
         if (!json_is_object(v)) return bad_value(m, "report", v, "an object");

@@ -92,6 +92,16 @@
  *   "cell_timeout_s": 1800,         optional: wall-clock limit of one cell
  *                                   (> 0; default none); a cell over it is
  *                                   killed and gets status "timeout"
+ *   "repeat": 3,                    optional, integer 1..100 (default 1): run
+ *                                   every cell but the reference runs this
+ *                                   many times, all cells once before any
+ *                                   twice (so slow drifts of the machine
+ *                                   spread over the cells); repetition k > 1
+ *                                   is a cell of its own (its id from the
+ *                                   settings and k; the first keeps the id a
+ *                                   matrix without repeat gives), cells.csv
+ *                                   gets a column "repeat" (1..N) and the
+ *                                   report gives the median and min-max
  *   "report": {"mg_levels": false}  optional: also tabulate mg_levels.csv
  *                                   (HOT Fig. 8 sparsity)
  * }
@@ -173,7 +183,7 @@ typedef struct {
     char base[256];           /* file name without directories, for messages */
     char dir[1024];           /* directory of the file */
     char name[64];
-    char description[1024];
+    const char *description;  /* the file's text, whole (owned by root); "" when none */
     MatrixSettings defaults;
     /* fixed axes: NULL / 0 = not an axis (the defaults' value) */
     char (*scenes)[1024];
@@ -194,6 +204,7 @@ typedef struct {
     char baseline[128];           /* "" = none */
     double cell_timeout_s;        /* 0 = none */
     int report_mg_levels;
+    int repeat;                   /* runs of every timed cell (>= 1) */
     MatrixReference reference;    /* top-level "reference" */
     int has_references;           /* some scene has a reference run */
     int uses_error_ref;           /* error_ref given anywhere: a cells.csv column */

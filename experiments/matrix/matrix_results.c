@@ -52,6 +52,7 @@ int matrix_results_header(const Matrix *m, char *out, size_t cap)
     for (int i = 0; i < 8; ++i) bad |= put(out, cap, &len, fixed[i], i == 0);
     if (m->uses_error_ref) bad |= put(out, cap, &len, "error_ref", 0);
     for (int a = 0; a < m->n_named; ++a) bad |= put(out, cap, &len, m->named[a].name, 0);
+    if (m->repeat > 1) bad |= put(out, cap, &len, "repeat", 0);
     if (m->has_references) {
         bad |= put(out, cap, &len, "role", 0);
         bad |= put(out, cap, &len, "reference", 0);
@@ -78,8 +79,9 @@ int matrix_results_row(const Matrix *m, const MatrixCell *c, const CellOutcome *
     char eps[32], scale[32], threads[16], frames[16], first[16], text[4096];
     matrix_format_number(c->eps, eps, sizeof eps);
     matrix_format_number(c->scale, scale, sizeof scale);
-    snprintf(threads, sizeof threads, "%d", c->threads);
-    snprintf(frames, sizeof frames, "%d", c->frames);
+    /* the counts the run used when the matrix left them to the scene / OpenMP (run.json) */
+    snprintf(threads, sizeof threads, "%d", c->threads > 0 || x->threads_run <= 0 ? c->threads : x->threads_run);
+    snprintf(frames, sizeof frames, "%d", c->frames > 0 || x->frames_run <= 0 ? c->frames : x->frames_run);
     snprintf(first, sizeof first, "%d", c->first_timed_frame);
     const char *fixed[] = {c->id, c->scene, c->solver, eps, scale, threads, frames, first};
     int bad = 0;
@@ -87,6 +89,11 @@ int matrix_results_row(const Matrix *m, const MatrixCell *c, const CellOutcome *
     for (int i = 0; i < 8; ++i) bad |= put(out, cap, &len, fixed[i], i == 0);
     if (m->uses_error_ref) bad |= put(out, cap, &len, c->error_ref, 0);
     for (int a = 0; a < m->n_named; ++a) bad |= put(out, cap, &len, m->named[a].values[c->value[a]].label, 0);
+    if (m->repeat > 1) {
+        char rep[16];
+        snprintf(rep, sizeof rep, "%d", c->repeat);
+        bad |= put(out, cap, &len, rep, 0);
+    }
     if (m->has_references) {
         bad |= put(out, cap, &len, c->is_reference ? "reference" : "cell", 0);
         bad |= put(out, cap, &len, c->ref_id, 0);

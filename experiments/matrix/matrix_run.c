@@ -33,8 +33,8 @@ typedef struct {
     CellsFile results;
     char dir[1024];
     int *todo;             /* cell indices to run, in dispatch order */
-    int n_todo, n_done_before, n_finished, n_skipped;
-    int n_status[5];
+    int n_todo, n_done_before, n_finished, n_skipped, n_busy;
+    int n_status[CELL_N_STATUS];
     double t_start, last_tick;
     int terminal, tick_shown;
 } Run;
@@ -149,14 +149,15 @@ static int cell_done(void *ctx, const MatrixResult *res)
     if (!st) st = cells_file_append(&r->results, row);
     r->n_finished++;
     r->n_status[res->outcome.status]++;
+    r->n_busy += res->outcome.busy;
     char name[1200], desc[1024];
     matrix_cell_name(c, name, sizeof name);
     matrix_cell_describe(&r->m, c, desc, sizeof desc);
     clear_tick(r);
-    printf("[%d/%d] %s %s %s: %s, %d frames, %d steps, %ld outer, %ld linear, %.2f s%s", r->n_finished, r->n_todo, c->id,
-           name, desc, cell_status_name(res->outcome.status), res->measure.frames, res->measure.steps,
+    printf("[%d/%d] %s %s %s: %s, %d frames, %d steps, %ld outer, %ld linear, %.2f s%s%s", r->n_finished, r->n_todo,
+           c->id, name, desc, cell_status_name(res->outcome.status), res->measure.frames, res->measure.steps,
            res->measure.outer_iters, res->measure.linear_iters, res->outcome.elapsed_s,
-           res->rank ? "" : "\n");
+           res->outcome.busy ? " (machine busy)" : "", res->rank ? "" : "\n");
     if (res->rank) printf(" (rank %d)\n", res->rank);
     fflush(stdout);
     return st;
@@ -298,6 +299,7 @@ static int fill_column(void *ctx, const char *id, const char *column, char *out,
         else if (!strcmp(column, "error_ref")) snprintf(out, cap, "%s", c->error_ref);
         else if (!strcmp(column, "role")) snprintf(out, cap, "%s", c->is_reference ? "reference" : "cell");
         else if (!strcmp(column, "reference")) snprintf(out, cap, "%s", c->ref_id);
+        else if (!strcmp(column, "repeat")) snprintf(out, cap, "%d", c->repeat);
         else return 0;
         return 1;
     }
@@ -423,9 +425,14 @@ int matrix_run(const char *file, const MatrixRunOptions *o)
         }
         if (rank == 0) {
             clear_tick(&r);
-            printf("matrix %s: %d cells ran (%d ok, %d bad-input, %d failed, %d crashed, %d timeout) in %.3f s; %s/cells.csv\n",
+            printf("matrix %s: %d cells ran (%d ok, %d bad-input, %d failed, %d crashed, %d timeout, %d time-limit) in "
+                   "%.3f s; %s/cells.csv\n",
                    r.m.name, r.n_finished, r.n_status[CELL_OK], r.n_status[CELL_BAD_INPUT], r.n_status[CELL_FAILED],
-                   r.n_status[CELL_CRASHED], r.n_status[CELL_TIMEOUT], matrix_now() - r.t_start, r.dir);
+                   r.n_status[CELL_CRASHED], r.n_status[CELL_TIMEOUT], r.n_status[CELL_TIME_LIMIT],
+                   matrix_now() - r.t_start, r.dir);
+            if (r.n_busy)
+                printf("matrix %s: %d cells ran while other processes used the machine (machine_busy = 1 in "
+                       "cells.csv): their times are not valid\n", r.m.name, r.n_busy);
             if (r.n_skipped)
                 printf("matrix %s: %d cells skipped: their reference run did not end ok\n", r.m.name, r.n_skipped);
             int failed = 0;

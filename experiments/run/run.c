@@ -14,6 +14,7 @@
 #include "experiments/run/library_startup.h"
 #include "experiments/run/paths.h"
 #include "experiments/run/ply.h"
+#include "experiments/run/vtk.h"
 #include "experiments/run/progress.h"
 #include "experiments/run/provenance.h"
 #include "experiments/run/registry.h"
@@ -76,6 +77,8 @@ int run_config_check(const RunConfig *cfg)
     if ((st = solve_settings_check(&set))) return st;
     if ((st = paths_check_output_dir("--out", cfg->out_dir))) return st;
     if ((st = paths_check_output_dir("--particles", cfg->particles_dir))) return st;
+    if ((st = paths_check_output_dir("--vtk", cfg->vtk_dir))) return st;
+    if (cfg->vtk_grid && !cfg->vtk_dir) return mpm_error(MPM_EINPUT, "--vtk-grid: needs --vtk DIR");
     AccuracyConfig acc = accuracy_config(cfg);
     if ((st = run_accuracy_check(&acc))) return st;
     const char *opts[RUN_MAX_SOLVER_OPTS];
@@ -276,8 +279,11 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     memset(&sim, 0, sizeof sim);
     FILE *steps_csv = NULL, *frames_csv = NULL, *iters_csv = NULL;
     StepWork work = {.dv = NULL, .cap = 0};
+    VtkSeries vtk;
+    memset(&vtk, 0, sizeof vtk);
     if ((status = paths_mkdir_p(out_dir))) goto done;
     if (cfg->particles_dir && (status = paths_mkdir_p(cfg->particles_dir))) goto done;
+    if (cfg->vtk_dir && (status = vtk_series_open(&vtk, cfg->vtk_dir, cfg->vtk_grid))) goto done;
     if (!(steps_csv = open_in(out_dir, "steps.csv", &status))) goto done;
     if (!(frames_csv = open_in(out_dir, "frames.csv", &status))) goto done;
     if (cfg->history && !(iters_csv = open_in(out_dir, "iters.csv", &status))) goto done;
@@ -289,11 +295,15 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
                        "inner_iters,max_energy_rise,%s,reason\n",
             run_accuracy_step_header);
     fprintf(frames_csv,
-            "scene,solver,frame,steps,outer_iters,linear_iters,wall_s,max_residual,status,threads,inner_iters,%s,reason\n",
+            "scene,solver,frame,steps,outer_iters,linear_iters,wall_s,max_residual,status,threads,inner_iters,complete,%s,"
+            "reason\n",
             run_accuracy_frame_header);
     if (iters_csv) fprintf(iters_csv, "frame,step,iter,elapsed_s,residual,energy\n");
 
     if ((status = sim_init(&sim, &scene))) goto done;
+    if (cfg->vtk_dir && (status = vtk_series_frame(&vtk, 0, sim.t, &sim.p, scene.materials, scene.n_materials, NULL,
+                                                   NULL)))
+        goto done;
     sum->particles = scene.particles.n;
     sum->threads = threads;
     Progress prog;
@@ -361,8 +371,9 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
                 break;
             }
         }
-        fprintf(frames_csv, "%s,%s,%d,%d,%ld,%ld,%.6f,%.6e,%s,%d,%ld,", scene.name, solver->name, frame, fsteps, fouter,
-                flinear, fwall, fmaxres, solve_status_name((SolveStatus)fstatus), threads, finner);
+        /* complete 0: the run's time limit cut the frame short (not a frame to time) */
+        fprintf(frames_csv, "%s,%s,%d,%d,%ld,%ld,%.6f,%.6e,%s,%d,%ld,%d,", scene.name, solver->name, frame, fsteps, fouter,
+                flinear, fwall, fmaxres, solve_status_name((SolveStatus)fstatus), threads, finner, sim.frame > frame);
         int acc_status = run_accuracy_frame_end(&acc, &sim, frame, fsteps, sim.frame > frame, frames_csv);
         csv_text(frames_csv, freason);
         fputc('\n', frames_csv);
@@ -379,6 +390,10 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
             snprintf(path, sizeof path, "%s/frame_%04d.ply", cfg->particles_dir, frame + 1);
             if ((status = ply_write_particles(path, &sim.p))) goto done;
         }
+        if (cfg->vtk_dir && !sum->stopped &&
+            (status = vtk_series_frame(&vtk, frame + 1, sim.t, &sim.p, scene.materials, scene.n_materials, &sim.grid,
+                                       sim.vnew)))
+            goto done;
         sum->frames++;
         sum->steps += fsteps;
         sum->outer_iters += fouter;
@@ -424,6 +439,7 @@ done:
     if (frames_csv) fclose(frames_csv);
     if (iters_csv) fclose(iters_csv);
     free(work.dv);
+    vtk_series_free(&vtk);
     run_accuracy_free(&acc);
     sim_free(&sim);
     solver_destroy(solver);

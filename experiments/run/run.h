@@ -30,6 +30,8 @@ typedef struct {
     int n_solver_opts;
     int history;                /* write iters.csv */
     const char *particles_dir;  /* PLY per frame when set */
+    const char *vtk_dir;        /* ParaView series (experiments/run/vtk.h) when set */
+    int vtk_grid;               /* with vtk_dir: also the grid series */
     const char *asset_dir;
     int armijo;                 /* the same as solver option linesearch=armijo */
     int quiet;                  /* no per-frame table */

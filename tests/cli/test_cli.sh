@@ -15,7 +15,7 @@ for s in drop bar3 stretched-box; do check "list scenes has $s" grep -q "^$s " "
 "$bin" run --scene drop --solver pn-pcg --frames 1 --out "$tmp/run" --history --quiet
 check "run exit 0" test $? -eq 0
 check "steps.csv header" grep -qx "scene,solver,frame,step,t,dt,particles,active_nodes,hessian_blocks,outer_iters,linear_iters,ls_evals,residual,status,wall_s,p2g_s,assemble_s,setup_s,solve_s,linesearch_s,g2p_s,threads,inner_iters,max_energy_rise,err_h,e_gap,err_v_max,ref_solver,ref_status,ref_s,reason" "$tmp/run/steps.csv"
-check "frames.csv header" grep -qx "scene,solver,frame,steps,outer_iters,linear_iters,wall_s,max_residual,status,threads,inner_iters,pos_rms,pos_max,vel_rms,reason" "$tmp/run/frames.csv"
+check "frames.csv header" grep -qx "scene,solver,frame,steps,outer_iters,linear_iters,wall_s,max_residual,status,threads,inner_iters,complete,pos_rms,pos_max,vel_rms,reason" "$tmp/run/frames.csv"
 check "iters.csv header" grep -qx "frame,step,iter,elapsed_s,residual,energy" "$tmp/run/iters.csv"
 check "every step converged" awk -F, 'NR>1 && $14!="converged"{bad=1} END{exit bad}' "$tmp/run/steps.csv"
 check "frames.csv has one row" test "$(wc -l <"$tmp/run/frames.csv")" -eq 2

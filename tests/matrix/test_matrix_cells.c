@@ -18,6 +18,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -119,8 +120,44 @@ static void test_outcome(void)
     CHECK(WIFSIGNALED(st) && o.status == CELL_CRASHED && o.exit_code == -11, "SIGSEGV: %d %d", o.status, o.exit_code);
     st = 9;
     CHECK(cell_outcome(st, 1, 1, 0).status == CELL_TIMEOUT, "killed by the runner");
-    CHECK(!strcmp(cell_status_name(CELL_BAD_INPUT), "bad-input") && !strcmp(cell_status_name(CELL_TIMEOUT), "timeout"),
+    CHECK(!strcmp(cell_status_name(CELL_BAD_INPUT), "bad-input") && !strcmp(cell_status_name(CELL_TIMEOUT), "timeout") &&
+              !strcmp(cell_status_name(CELL_TIME_LIMIT), "time-limit"),
           "names");
+    /* busy: other processes' CPU over (cores - threads + 0.1) x elapsed */
+    CHECK(!cell_busy(0.19, 2.0, 2, 2) && cell_busy(0.21, 2.0, 2, 2), "2 threads on 2 cores: a tenth of a core is busy");
+    CHECK(!cell_busy(2.19, 2.0, 1, 2) && cell_busy(2.21, 2.0, 1, 2), "1 thread on 2 cores: the free core may be used");
+    CHECK(cell_busy(0.3, 2.0, 0, 2) && !cell_busy(-1.0, 2.0, 2, 2) && !cell_busy(5.0, 0.0, 2, 2),
+          "threads unknown: no core free; unknown load or no time: not busy");
+}
+
+/* cell_measure on a hand-made cell directory: a frame the run's time limit
+ * cut short (complete 0, or in files older than that column, status timeout
+ * with the run limit as its reason) is not a frame. */
+static void test_measure_cut_short(void)
+{
+    char dir[300], path[400];
+    snprintf(dir, sizeof dir, "%s/cut", g_dir);
+    mkdir(dir, 0755);
+    snprintf(path, sizeof path, "%s/frames.csv", dir);
+    FILE *f = fopen(path, "w");
+    fprintf(f, "frame,steps,outer_iters,linear_iters,wall_s,max_residual,status,complete,reason\n"
+               "0,2,4,8,1.0,1e-8,converged,1,\"\"\n1,2,4,8,3.0,1e-8,converged,1,\"\"\n"
+               "2,1,9,90,0.5,1e-3,timeout,0,\"time limit --max-run-seconds 4 reached in PCG\"\n");
+    fclose(f);
+    CellMeasure m;
+    cell_measure(dir, 1, &m);
+    CHECK(m.frames == 2 && m.timed_frames == 1 && m.cut_short, "cut frame not counted: %d %d %d", m.frames,
+          m.timed_frames, m.cut_short);
+    CHECK(m.timed_wall_s == 3.0 && m.max_frame_s == 3.0 && m.wall_s == 4.5, "times: %g %g %g", m.timed_wall_s,
+          m.max_frame_s, m.wall_s);
+    CHECK(!strcmp(m.worst_solve_status, "timeout") && m.outer_iters == 8, "worst status kept, iterations of frames");
+    f = fopen(path, "w"); /* the format before the complete column */
+    fprintf(f, "frame,steps,outer_iters,linear_iters,wall_s,max_residual,status,reason\n"
+               "0,2,4,8,1.0,1e-8,timeout,\"time limit --max-step-seconds 1 reached\"\n"
+               "1,1,9,90,0.5,1e-3,timeout,\"time limit --max-run-seconds 4 reached in PCG\"\n");
+    fclose(f);
+    cell_measure(dir, 0, &m);
+    CHECK(m.frames == 1 && m.timed_wall_s == 1.0 && m.cut_short, "old format: step limit is a frame, run limit is not");
 }
 
 static void test_launcher_env(void)
@@ -246,6 +283,7 @@ int main(void)
     test_numbers();
     test_csv();
     test_outcome();
+    test_measure_cut_short();
     test_launcher_env();
     test_ids();
     test_cells_file();

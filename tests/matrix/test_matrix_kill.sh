@@ -52,7 +52,8 @@ done
 for r in $(seq "$round"); do
 python3 - "$tmp/ref/cells.csv" "$tmp/res$r/cells.csv" >"$tmp/cmp.txt" 2>&1 <<'PY'
 import csv, sys
-times = {"wall_s", "timed_wall_s", "s_per_frame", "max_frame_s", "peak_rss_mb", "startup_s", "elapsed_s"}
+times = {"wall_s", "timed_wall_s", "s_per_frame", "max_frame_s", "peak_rss_mb", "startup_s", "elapsed_s",
+         "cpu_s", "others_cpu_s", "load_start", "machine_busy"}
 ref = list(csv.DictReader(open(sys.argv[1])))
 got = list(csv.DictReader(open(sys.argv[2])))
 ids = [r["id"] for r in got]
