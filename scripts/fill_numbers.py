@@ -80,6 +80,24 @@ def num(r, col):
     return v
 
 
+def summary(study):
+    """DIR/summary.json, the report's answer in numbers (scripts/matrix_report.py)."""
+    path = os.path.join(RESULTS, study, "summary.json")
+    if path not in _cache:
+        if not os.path.exists(path):
+            raise Missing(f"results/{study}/summary.json does not exist (rerun mpmbench matrix report)")
+        with open(path) as f:
+            _cache[path] = json.load(f)
+    return _cache[path]
+
+
+def solver_summary(study, solver):
+    s = summary(study).get("solvers", {})
+    if solver not in s:
+        raise Missing(f"results/{study}/summary.json has no solver {solver}")
+    return s[solver]
+
+
 def provenance(study):
     path = os.path.join(RESULTS, study, "provenance.json")
     if not os.path.exists(path):
@@ -119,8 +137,23 @@ def of(k, n):
 # ---- the numbers -------------------------------------------------------------
 
 def cells_ok(study):
-    c = table(study, "cells.csv")
-    return of(sum(r["status"] == "ok" for r in c), len(c))
+    """Cell runs that ended ok, as the report counts them."""
+    sm = summary(study)
+    return of(sm.get("status", {}).get("ok", 0), sm["cells"])
+
+
+def fastest(study, solver):
+    s = solver_summary(study, solver)
+    return of(s["fastest_in"], s["fastest_of"])
+
+
+def geomean(study, solver):
+    return sig(solver_summary(study, solver)["speedup_geomean"])
+
+
+def speedup_range(study, solver):
+    s = solver_summary(study, solver)
+    return f"{sig(s['speedup_min'])}-{sig(s['speedup_max'])}"
 
 
 def cells_total_minutes(study):
@@ -268,6 +301,13 @@ NUMBERS = {
     "scenes.n_solvers": lambda: scenes_count("solver"),
     "scenes.particles_max": scenes_particles_max,
     "scenes.hot_fastest": scenes_hot_fastest,
+    "scenes.hot_fastest_summary": lambda: fastest("scenes-bench", "hot"),
+    "scenes.hot_geomean": lambda: geomean("scenes-bench", "hot"),
+    "scenes.hot_range": lambda: speedup_range("scenes-bench", "hot"),
+    "history.cells": lambda: cells_ok("scenes-history"),
+    "history.date": lambda: run_date("scenes-history"),
+    "history.hot_geomean": lambda: geomean("scenes-history", "hot"),
+    "stiffness.hot_geomean": lambda: geomean("stiffness", "hot"),
     "scenes.hot_within_2x": lambda: scenes_hot_within(2.0),
     "scenes.hot_vs_pn-pcg_paper": lambda: scenes_speedup("hot", PAPER_SCENES),
     "scenes.pn-mgpcg_vs_pn-pcg_paper": lambda: scenes_speedup("pn-mgpcg", PAPER_SCENES),

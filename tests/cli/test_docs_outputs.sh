@@ -26,7 +26,7 @@ cat >"$tmp/m.json" <<'JSON'
  "axes": {"solver": ["hot"], "error_ref": ["pn-pcg:1e-9"],
           "sets": {"stiff": [{"materials.soft.E": 1e5}]}},
  "reference": {"solver": "pn-pcg", "eps": 1e-9},
- "baseline": "hot"}
+ "baseline": "hot", "repeat": 2}
 JSON
 check "matrix run --check" "$bin" matrix run "$tmp/m.json" --out "$tmp/m" --check >>"$tmp/log" 2>&1
 check "matrix report" "$bin" matrix report "$tmp/m" >>"$tmp/log" 2>&1

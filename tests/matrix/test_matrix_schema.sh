@@ -44,7 +44,7 @@ probe every-scene-key valid "{\"name\": \"t\", $ax, \"scenes\": {\"drop\": {\"sc
   \"first_timed_frame\": 1, \"set\": {\"frames\": 3}, \"error_ref\": \"auto\", \"max_outer\": 9, \"max_linear\": 9,
   \"max_step_seconds\": 5, \"max_run_seconds\": 9, \"on_failure\": \"stop\", \"reference\": false}}}"
 probe top-level-rest valid "{\"name\": \"t\", $ax, \"include\": [{\"solver\": [\"hot\"]}], \"exclude\": [{\"scene\": \"drop\", \"eps\": 1e-3}],
-  \"baseline\": \"hot\", \"cell_timeout_s\": 60, \"report\": {\"mg_levels\": true},
+  \"baseline\": \"hot\", \"cell_timeout_s\": 60, \"report\": {\"mg_levels\": true}, \"repeat\": 3,
   \"reference\": {\"solver\": \"pn-cholmod\", \"eps\": 1e-10, \"solver_opts\": {}}}"
 probe scene-reference valid "{\"name\": \"t\", $ax, \"scenes\": {\"drop\": {\"reference\": {\"solver\": \"pn-pcg\"}}}}"
 
@@ -72,5 +72,8 @@ probe rule-empty-list invalid "{\"name\": \"t\", $ax, \"include\": [{\"solver\":
 probe reference-no-solver invalid "{\"name\": \"t\", $ax, \"reference\": {\"eps\": 1e-9}}"
 probe reference-unknown-key invalid "{\"name\": \"t\", $ax, \"reference\": {\"solver\": \"hot\", \"tol\": 1}}"
 probe timeout-zero invalid "{\"name\": \"t\", $ax, \"cell_timeout_s\": 0}"
+probe repeat-zero invalid "{\"name\": \"t\", $ax, \"repeat\": 0}"
+probe repeat-real invalid "{\"name\": \"t\", $ax, \"repeat\": 2.5}"
+probe repeat-huge invalid "{\"name\": \"t\", $ax, \"repeat\": 101}"
 probe report-unknown invalid "{\"name\": \"t\", $ax, \"report\": {\"figures\": true}}"
 finish
