@@ -23,7 +23,7 @@ else
   [ -f "tests/fuzz/fuzz_$what.c" ] || { echo "fuzz.sh: no harness tests/fuzz/fuzz_$what.c" >&2; exit 2; }
   targets=("$what")
 fi
-command -v clang >/dev/null || { echo "fuzz.sh: needs clang (scripts/setup.sh installs it)" >&2; exit 2; }
+command -v clang >/dev/null || { echo "fuzz.sh: needs clang (scripts/test.sh installs it)" >&2; exit 2; }
 
 build=${MPM_FUZZ_BUILD:-build-fuzz}
 if [ ! -f "$build/CMakeCache.txt" ]; then

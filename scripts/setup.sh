@@ -5,9 +5,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+# what building and running need (python3-matplotlib: `matrix report`'s
+# figures); what only testing needs is installed by scripts/test.sh
 packages=(build-essential cmake pkg-config python3 python3-matplotlib libhypre-dev libsuitesparse-dev libgsl-dev
-          libopenmpi-dev openmpi-bin libjansson-dev libpng-dev libopenblas0
-          clang libclang-rt-14-dev libomp-dev valgrind) # the last four: fuzzing and checking (scripts/test.sh)
+          libopenmpi-dev openmpi-bin libjansson-dev libpng-dev libopenblas0)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,25 +1,42 @@
 #!/usr/bin/env bash
-# The test command (CI runs exactly this, via .ci/run):
-#   1. setup (packages + build/) and the whole CTest suite;
+# The test command (CI runs exactly `bash scripts/test.sh`, via .ci/run):
+#   0. setup (scripts/setup.sh: packages + build/) and the packages only
+#      testing needs (installed here when missing);
+#   1. the whole CTest suite on the release build;
 #   2. the unit tests again in an ASan + UBSan build (build-asan: any
 #      address error, leak or undefined behaviour fails the test);
-#   3. each libFuzzer target for MPM_FUZZ_SECONDS (default 60) seconds.
-# Extra arguments go to the first ctest. MPM_QUICK=1 runs step 1 only.
+#   3. each libFuzzer target for MPM_FUZZ_SECONDS (default 60) seconds;
+#   4. valgrind (memcheck, leaks) on a short run that exercises a solver.
+# `bash scripts/test.sh --quick` runs steps 0 and 1 only (the release suite);
+# so does MPM_QUICK=1. Other arguments go to the first ctest.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+quick=${MPM_QUICK:-0}
+if [ "${1:-}" = --quick ]; then quick=1; shift; fi
 bash scripts/setup.sh
-# what only the tests need: VTK's Python reader (tests/cli/test_vtk.sh reads the ParaView output back)
-if ! dpkg-query -W -f='${Status}' python3-vtk9 2>/dev/null | grep -q "install ok installed"; then
-  echo "test.sh: installing python3-vtk9" >&2
+
+# packages only testing needs: clang + its sanitizer runtime + libomp (the
+# fuzz build), valgrind (step 4), python3-jsonschema (tests/matrix/
+# test_matrix_schema.sh validates the matrix files against
+# docs/matrix.schema.json), python3-vtk9 (tests/cli/test_vtk.sh reads the
+# ParaView output back with VTK's reader)
+test_packages=(clang libclang-rt-14-dev libomp-dev valgrind python3-jsonschema python3-vtk9)
+missing=()
+for p in "${test_packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
   sudo=""
   [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  echo "test.sh: installing ${missing[*]}" >&2
   $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends python3-vtk9 >/dev/null
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
+
 t0=$SECONDS
 ctest --test-dir build --output-on-failure -j2 "$@"
 echo "test.sh: release suite $((SECONDS - t0)) s" >&2
-[ "${MPM_QUICK:-0}" = 1 ] && exit 0
+[ "$quick" = 1 ] && exit 0
 
 # --- 2. sanitizers ---------------------------------------------------------
 # Tests too slow under ASan for CI's budget are listed here (and printed),
@@ -46,10 +63,20 @@ export ASAN_OPTIONS="halt_on_error=1:abort_on_error=1:detect_leaks=1:strict_stri
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 export LSAN_OPTIONS="suppressions=$PWD/tests/sanitizer/lsan.supp:fast_unwind_on_malloc=0:print_suppressions=0"
 echo "test.sh: ASan+UBSan unit tests (not run under ASan, too slow for CI: ${asan_skip:-none})" >&2
-ctest --test-dir build-asan --output-on-failure -j2 -E "^(${asan_skip:-none}|test_cli|test_render_cmd|test_scenes_run|test_summarize)\$"
+ctest --test-dir build-asan --output-on-failure -j2 -E "^(${asan_skip:-none}|test_cli|test_render_cmd|test_scenes_run|test_summarize|test_docs_solvers|test_fill_numbers|test_matrix_schema)\$"
 echo "test.sh: sanitizer suite $((SECONDS - t0)) s" >&2
 
 # --- 3. fuzzing ------------------------------------------------------------
 t0=$SECONDS
 bash scripts/fuzz.sh all "${MPM_FUZZ_SECONDS:-60}"
 echo "test.sh: fuzzing $((SECONDS - t0)) s" >&2
+
+# --- 4. valgrind -------------------------------------------------------------
+# bar3's stiff middle at a coarse scale: a few Newton and PCG iterations per
+# step, one thread (OpenMP's thread pool is not what is under test)
+t0=$SECONDS
+vg_out=$(mktemp -d)
+OMP_NUM_THREADS=1 valgrind -q --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=definite,indirect \
+  build/mpmbench run --scene bar3 --solver pn-pcg --scale 4 --frames 1 --quiet --out "$vg_out"
+rm -rf "$vg_out"
+echo "test.sh: valgrind $((SECONDS - t0)) s" >&2

@@ -1,0 +1,425 @@
+#!/usr/bin/env python3
+"""Fills the numbers quoted in the documentation from the committed results.
+
+Markdown files carry markers around every number taken from a study:
+
+    HOT is the fastest on <!-- n:scenes.hot_fastest -->10 of 13<!-- /n --> scenes
+
+The key after "n:" names a function below, which computes the text from the
+files in results/ (report.csv, cells.csv, check.csv, wp.csv, provenance.json,
+mg_levels.csv); the text between the markers is its value. The markers are
+HTML comments, so they do not show in rendered markdown.
+
+    python3 scripts/fill_numbers.py           rewrite every marker's text
+    python3 scripts/fill_numbers.py --check   exit 1 and list the markers whose
+                                              text differs from the results
+    python3 scripts/fill_numbers.py --list    print every key and its value
+
+Files: README.md, results/README.md, docs/*.md, or the files given after the
+mode (`--check FILE ...`). A marker with an unknown key,
+or a key whose data is missing, is an error in every mode. The test suite runs
+--check (tests/matrix/test_fill_numbers.sh), so a regenerated report that
+changes a quoted number fails it until this script is rerun, and a number
+typed by hand into a marker fails it at once.
+"""
+import csv
+import glob
+import json
+import math
+import os
+import re
+import statistics
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+RESULTS = os.path.join(ROOT, "results")
+MARKER = re.compile(r"<!-- n:([A-Za-z0-9_.+-]+) -->(.*?)<!-- /n -->", re.S)
+PAPER_SCENES = ["twist", "boxes", "donut", "armacat-soft", "armacat-stiff", "chain", "boards", "wheel",
+                "faceless", "sauce"]
+
+
+class Missing(Exception):
+    pass
+
+
+# ---- reading ---------------------------------------------------------------
+
+_cache = {}
+
+
+def table(study, name):
+    path = os.path.join(RESULTS, study, name)
+    if path not in _cache:
+        if not os.path.exists(path):
+            raise Missing(f"results/{study}/{name} does not exist")
+        with open(path, newline="") as f:
+            _cache[path] = list(csv.DictReader(f))
+    return _cache[path]
+
+
+def rows(study, name="report.csv", **where):
+    """Rows of a CSV whose columns equal the given values."""
+    out = [r for r in table(study, name) if all(r.get(k) == v for k, v in where.items())]
+    if not out:
+        raise Missing(f"results/{study}/{name}: no row with {where}")
+    return out
+
+
+def one(study, name="report.csv", **where):
+    r = rows(study, name, **where)
+    if len(r) != 1:
+        raise Missing(f"results/{study}/{name}: {len(r)} rows with {where}, expected one")
+    return r[0]
+
+
+def num(r, col):
+    try:
+        v = float(r[col])
+    except (KeyError, ValueError):
+        raise Missing(f"column {col} is missing or not a number in {r}")
+    return v
+
+
+def summary(study):
+    """DIR/summary.json, the report's answer in numbers (scripts/matrix_report.py)."""
+    path = os.path.join(RESULTS, study, "summary.json")
+    if path not in _cache:
+        if not os.path.exists(path):
+            raise Missing(f"results/{study}/summary.json does not exist (rerun mpmbench matrix report)")
+        with open(path) as f:
+            _cache[path] = json.load(f)
+    return _cache[path]
+
+
+def solver_summary(study, solver):
+    s = summary(study).get("solvers", {})
+    if solver not in s:
+        raise Missing(f"results/{study}/summary.json has no solver {solver}")
+    return s[solver]
+
+
+def provenance(study):
+    path = os.path.join(RESULTS, study, "provenance.json")
+    if not os.path.exists(path):
+        raise Missing(f"results/{study}/provenance.json does not exist")
+    with open(path) as f:
+        p = json.load(f)
+    inv = p.get("invocations") or []
+    if not inv:
+        raise Missing(f"results/{study}/provenance.json has no invocation")
+    return inv
+
+
+# ---- formatting ------------------------------------------------------------
+
+def sig(v, digits=3):
+    """v with `digits` significant digits, plain notation where short."""
+    if v == 0 or not math.isfinite(v):
+        return f"{v:g}"
+    e = math.floor(math.log10(abs(v)))
+    if -4 <= e < 6:
+        return f"{v:.{max(digits - 1 - e, 0)}f}"
+    return f"{v:.{digits - 1}e}"
+
+
+def grouped(n):
+    return f"{int(round(n)):,}"
+
+
+def span(values, digits=3, sep="-"):
+    return f"{sig(min(values), digits)}{sep}{sig(max(values), digits)}"
+
+
+def of(k, n):
+    return f"{k} of {n}"
+
+
+# ---- the numbers -------------------------------------------------------------
+
+def cells_ok(study):
+    """Cell runs that ended ok, as the report counts them."""
+    sm = summary(study)
+    return of(sm.get("status", {}).get("ok", 0), sm["cells"])
+
+
+def fastest(study, solver):
+    s = solver_summary(study, solver)
+    return of(s["fastest_in"], s["fastest_of"])
+
+
+def geomean(study, solver):
+    return sig(solver_summary(study, solver)["speedup_geomean"])
+
+
+def speedup_range(study, solver):
+    s = solver_summary(study, solver)
+    return f"{sig(s['speedup_min'])}-{sig(s['speedup_max'])}"
+
+
+def cells_total_minutes(study):
+    return f"{sum(num(r, 'elapsed_s') for r in table(study, 'cells.csv')) / 60:.0f}"
+
+
+def run_date(study):
+    return provenance(study)[0]["start_time"][:10]
+
+
+def run_cpu(study):
+    p = provenance(study)[0]
+    return f"{p['cpu_model']}, {p['cores_online']} cores"
+
+
+def fastest_per_case(study):
+    best = {}
+    for r in table(study, "report.csv"):
+        if r["status"] != "ok" or not r["s_per_frame"]:
+            continue
+        t = float(r["s_per_frame"])
+        if r["case"] not in best or t < best[r["case"]][1]:
+            best[r["case"]] = (r["solver"], t)
+    if not best:
+        raise Missing(f"results/{study}/report.csv: no ok row")
+    return best
+
+
+def scenes_hot_fastest():
+    best = fastest_per_case("scenes-bench")
+    return of(sum(s == "hot" for s, _ in best.values()), len(best))
+
+
+def scenes_hot_within(factor):
+    best = fastest_per_case("scenes-bench")
+    k = 0
+    for case, (_, t) in best.items():
+        h = one("scenes-bench", case=case, solver="hot")
+        k += h["status"] == "ok" and float(h["s_per_frame"]) <= factor * t
+    return of(k, len(best))
+
+
+def scenes_speedup(solver, scenes):
+    return span([num(one("scenes-bench", scene=s, solver=solver), "speedup_total") for s in scenes])
+
+
+def scenes_particles_max():
+    return grouped(max(num(r, "particles") for r in table("scenes-bench", "cells.csv")))
+
+
+def scenes_count(col):
+    return str(len({r[col] for r in table("scenes-bench", "report.csv")}))
+
+
+def stiffness_speedup(solver, modulus):
+    return sig(num(one("stiffness", case=f"bar3 stiffness={modulus}", solver=solver), "speedup_total"))
+
+
+def stiffness_iters(solver):
+    lo = num(one("stiffness", case="bar3 stiffness=1e+05", solver=solver), "outer_iters")
+    hi = num(one("stiffness", case="bar3 stiffness=1e+11", solver=solver), "outer_iters")
+    return f"{lo:.0f} to {hi:.0f}"
+
+
+def wp_err_h_range(eps):
+    vals = [float(r["err_h_median"]) for r in table("work-precision", "wp.csv")
+            if r["status"] == "ok" and r["eps"] and float(r["eps"]) == eps and r["err_h_median"]]
+    if not vals:
+        raise Missing(f"results/work-precision/wp.csv: no ok row at eps {eps}")
+    return f"{sig(min(vals), 2)} to {sig(max(vals), 2)}"
+
+
+def wp_err_h_spread(eps):
+    """The largest ratio of median err_h between two solvers on one case at this eps."""
+    by = {}
+    for r in table("work-precision", "wp.csv"):
+        if r["status"] == "ok" and r["eps"] and float(r["eps"]) == eps and r["err_h_median"]:
+            by.setdefault(r["case"], []).append(float(r["err_h_median"]))
+    ratios = [max(v) / min(v) for v in by.values() if len(v) > 1 and min(v) > 0]
+    if not ratios:
+        raise Missing("results/work-precision/wp.csv: no case with two solvers")
+    return f"{max(ratios):.0f}"
+
+
+def check_passed(study):
+    c = table(study, "check.csv")
+    return of(sum(r["pass"] == "1" for r in c), len(c))
+
+
+def smoke_converged():
+    c = table("smoke-matrix", "cells.csv")
+    return of(sum(r["status"] == "ok" and float(r["converged_fraction"]) == 1 for r in c), len(c))
+
+
+def fig18_speedup(scene, solver="gast15"):
+    return sig(num(one("gast15-fig18", scene=scene, solver=solver), "speedup_total"))
+
+
+def table1_ratio(scene, slow, fast):
+    a = num(one("gast15-table1", scene=scene, solver=slow), "s_per_frame")
+    b = num(one("gast15-table1", scene=scene, solver=fast), "s_per_frame")
+    return sig(a / b, 2)
+
+
+def table3_iteration_ratio():
+    ratios = []
+    for r in rows("table3", solver="pn-sgs-pcg"):
+        j = one("table3", case=r["case"], solver="pn-pcg")
+        ratios.append(num(j, "linear_per_step") / num(r, "linear_per_step"))
+    return span(ratios, 2)
+
+
+def table3_speed():
+    return span([num(r, "speedup_total") for r in rows("table3", solver="pn-sgs-pcg")], 2)
+
+
+def foundation_mf():
+    return sig(num(one("foundation", solver="pn-pcg-mf"), "speedup_total"))
+
+
+def foundation_bench(key, digits=3):
+    path = os.path.join(RESULTS, "foundation", "bench.txt")
+    if not os.path.exists(path):
+        raise Missing("results/foundation/bench.txt does not exist")
+    with open(path) as f:
+        for line in f:
+            if line.startswith(key + "="):
+                return sig(float(line.split("=", 1)[1]), digits)
+    raise Missing(f"results/foundation/bench.txt has no {key}=")
+
+
+def fig8_blocks(solver, level):
+    cell = one("fig8", "cells.csv", solver=solver)
+    lv = rows("fig8", os.path.join("cells", cell["id"], "mg_levels.csv"), level=str(level))[0]
+    return f"{float(lv['blocks_per_row_avg']):.0f}"
+
+
+NUMBERS = {
+    "scenes.cells": lambda: cells_ok("scenes-bench"),
+    "scenes.minutes": lambda: cells_total_minutes("scenes-bench"),
+    "scenes.date": lambda: run_date("scenes-bench"),
+    "scenes.cpu": lambda: run_cpu("scenes-bench"),
+    "scenes.cores": lambda: str(provenance("scenes-bench")[0]["cores_online"]),
+    "scenes.n_scenes": lambda: scenes_count("scene"),
+    "scenes.n_solvers": lambda: scenes_count("solver"),
+    "scenes.particles_max": scenes_particles_max,
+    "scenes.hot_fastest": scenes_hot_fastest,
+    "scenes.hot_fastest_summary": lambda: fastest("scenes-bench", "hot"),
+    "scenes.hot_geomean": lambda: geomean("scenes-bench", "hot"),
+    "scenes.hot_range": lambda: speedup_range("scenes-bench", "hot"),
+    "history.cells": lambda: cells_ok("scenes-history"),
+    "history.date": lambda: run_date("scenes-history"),
+    "history.hot_geomean": lambda: geomean("scenes-history", "hot"),
+    "stiffness.hot_geomean": lambda: geomean("stiffness", "hot"),
+    "scenes.hot_within_2x": lambda: scenes_hot_within(2.0),
+    "scenes.hot_vs_pn-pcg_paper": lambda: scenes_speedup("hot", PAPER_SCENES),
+    "scenes.pn-mgpcg_vs_pn-pcg_paper": lambda: scenes_speedup("pn-mgpcg", PAPER_SCENES),
+    "scenes.pn-amg-pcg_vs_pn-pcg_all": lambda: scenes_speedup(
+        "pn-amg-pcg", sorted({r["scene"] for r in table("scenes-bench", "report.csv")})),
+    "mpi.cells": lambda: cells_ok("scenes-mpi2x1"),
+    "mpi.date": lambda: run_date("scenes-mpi2x1"),
+    "mpi.n_scenes": lambda: str(len({r["scene"] for r in table("scenes-mpi2x1", "cells.csv")})),
+    "stiffness.cells": lambda: cells_ok("stiffness"),
+    "stiffness.date": lambda: run_date("stiffness"),
+    "stiffness.hot_vs_pn-pcg_1e9": lambda: stiffness_speedup("hot", "1e+09"),
+    "stiffness.hot_vs_pn-pcg_1e11": lambda: stiffness_speedup("hot", "1e+11"),
+    "stiffness.hot_iters": lambda: stiffness_iters("hot"),
+    "stiffness.pn-pcg_iters": lambda: stiffness_iters("pn-pcg"),
+    "wp.cells": lambda: cells_ok("work-precision"),
+    "wp.date": lambda: run_date("work-precision"),
+    "wp.err_h_range_at_1e-7": lambda: wp_err_h_range(1e-7),
+    "wp.err_h_spread_at_1e-7": lambda: wp_err_h_spread(1e-7),
+    "stress.cells": lambda: cells_ok("stress"),
+    "stress.date": lambda: run_date("stress"),
+    "stress.passed": lambda: check_passed("stress"),
+    "smoke.cells": lambda: cells_ok("smoke-matrix"),
+    "smoke.date": lambda: run_date("smoke-matrix"),
+    "smoke.converged": smoke_converged,
+    "fig18.cells": lambda: cells_ok("gast15-fig18"),
+    "fig18.date": lambda: run_date("gast15-fig18"),
+    "fig18.gast15_vs_semi_drop": lambda: fig18_speedup("snowball-drop"),
+    "fig18.gast15_vs_semi_wall": lambda: fig18_speedup("snowball-wall"),
+    "fig18.gast15_vs_semi_collide": lambda: fig18_speedup("snowball-collide"),
+    "table1.cells": lambda: cells_ok("gast15-table1"),
+    "table1.date": lambda: run_date("gast15-table1"),
+    "table1.gast15-hot_over_hot_bar3": lambda: table1_ratio("bar3", "gast15-hot", "hot"),
+    "table3.cells": lambda: cells_ok("table3"),
+    "table3.date": lambda: run_date("table3"),
+    "table3.sgs_fewer_iterations": table3_iteration_ratio,
+    "table3.sgs_speed": table3_speed,
+    "fig8.cells": lambda: cells_ok("fig8"),
+    "fig8.date": lambda: run_date("fig8"),
+    "fig8.hot_level0": lambda: fig8_blocks("hot", 0),
+    "fig8.hot_level4": lambda: fig8_blocks("hot", 4),
+    "fig8.gmg_level4": lambda: fig8_blocks("lbfgs-gmg", 4),
+    "foundation.cells": lambda: cells_ok("foundation"),
+    "foundation.date": lambda: run_date("foundation"),
+    "foundation.mf_speedup": foundation_mf,
+    "foundation.spmv_gbs": lambda: foundation_bench("spmv_gbs"),
+    "foundation.spmv_stream_ratio": lambda: foundation_bench("spmv_stream_ratio", 2),
+}
+
+
+def value(key):
+    if key not in NUMBERS:
+        raise Missing(f"unknown key '{key}' (keys: scripts/fill_numbers.py NUMBERS)")
+    return NUMBERS[key]()
+
+
+def files():
+    out = [os.path.join(ROOT, "README.md"), os.path.join(RESULTS, "README.md")]
+    out += sorted(glob.glob(os.path.join(ROOT, "docs", "*.md")))
+    return [f for f in out if os.path.exists(f)]
+
+
+def main(argv):
+    mode = argv[0] if argv else "--write"
+    paths = [os.path.abspath(a) for a in argv[1:]] or files()
+    if mode not in ("--write", "--check", "--list"):
+        print(__doc__, file=sys.stderr)
+        return 2
+    if mode == "--list":
+        bad = 0
+        for k in NUMBERS:
+            try:
+                print(f"{k}: {value(k)}")
+            except Missing as e:
+                print(f"{k}: ERROR {e}")
+                bad = 1
+        return bad
+    problems, changed, markers = [], [], 0
+    for path in paths:
+        with open(path) as f:
+            text = f.read()
+
+        def repl(m):
+            nonlocal markers
+            markers += 1
+            key, old = m.group(1), m.group(2)
+            try:
+                new = value(key)
+            except Missing as e:
+                problems.append(f"{os.path.relpath(path, ROOT)}: {key}: {e}")
+                return m.group(0)
+            if new != old:
+                changed.append(f"{os.path.relpath(path, ROOT)}: {key}: '{old}' -> '{new}'")
+            return f"<!-- n:{key} -->{new}<!-- /n -->"
+
+        new_text = MARKER.sub(repl, text)
+        if mode == "--write" and new_text != text:
+            with open(path, "w") as f:
+                f.write(new_text)
+    for p in problems:
+        print(f"fill_numbers: {p}", file=sys.stderr)
+    if mode == "--check":
+        for c in changed:
+            print(f"fill_numbers: stale: {c}", file=sys.stderr)
+        if changed:
+            print("fill_numbers: run python3 scripts/fill_numbers.py to update", file=sys.stderr)
+        print(f"fill_numbers: {markers} markers, {len(changed)} stale, {len(problems)} errors", file=sys.stderr)
+        return 1 if changed or problems else 0
+    for c in changed:
+        print(f"fill_numbers: updated {c}")
+    print(f"fill_numbers: {markers} markers, {len(changed)} updated, {len(problems)} errors", file=sys.stderr)
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
