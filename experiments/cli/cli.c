@@ -48,7 +48,7 @@ static int is_help(const char *a) { return !strcmp(a, "-h") || !strcmp(a, "--hel
 
 int cli_parse(const Command *cmd, int argc, char **argv, int first, void *args, const char **operand, int *help)
 {
-    memset(args, 0, cmd->args_size);
+    if (cmd->args_size) memset(args, 0, cmd->args_size); /* a command without options has no args struct */
     if (cmd->init) cmd->init(args);
     *operand = NULL;
     *help = 0;
