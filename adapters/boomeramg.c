@@ -1,4 +1,4 @@
-/* hypre BoomerAMG V-cycle behind the InvApprox interface (DESIGN "the one
+/* hypre BoomerAMG V-cycle behind the InvApprox interface (docs/design.md, "the one
  * idea": PN-AMG-PCG and LBFGS-AMG; SPEC 7).
  *
  * API use follows the hypre Reference Manual and User's Manual (2.26,

@@ -1,4 +1,4 @@
-/* hypre BoomerAMG as an inverse approximation (DESIGN "the one idea": the
+/* hypre BoomerAMG as an inverse approximation (docs/design.md, "the one idea": the
  * algebraic baseline PN-AMG-PCG, and LBFGS-AMG of SPEC 7).
  *
  * inv_boomeramg_ops ("boomeramg"): apply = exactly one BoomerAMG V-cycle from

@@ -1,4 +1,4 @@
-/* CHOLMOD direct solver behind the InvApprox interface (DESIGN "the one idea":
+/* CHOLMOD direct solver behind the InvApprox interface (docs/design.md, "the one idea":
  * PN-CHOLMOD and LBFGS-H-direct; SPEC 7).
  *
  * API use follows the CHOLMOD user guide (SuiteSparse 5.x, CHOLMOD/Doc/

@@ -1,5 +1,5 @@
 /* Particle sources: material poured into the scene while it runs (HOT's
- * SourceCollisionObject, reference/hot-scenes.md sections 3.6 Boards and
+ * SourceCollisionObject, docs/scenes.md §4, hot-scenes.md sections 3.6 Boards and
  * 3.9 Sauce).
  *
  * JSON form (an entry of the scene's "sources" array; unknown fields are

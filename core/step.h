@@ -1,4 +1,4 @@
-/* The two halves of a timestep around the solve (SPEC 2; DESIGN data flow):
+/* The two halves of a timestep around the solve (SPEC 2; docs/design.md, data flow):
  *   step_begin: colliders at t^n, dt from CFL and frame boundaries, particle
  *               sort, sparse grid (MLS: the stencils' gradients become
  *               the MLS substitute, SPEC 9), P2G (MLS: the fused form),

@@ -1,4 +1,4 @@
-/* The inverse-Hessian approximation interface (DESIGN "the one idea").
+/* The inverse-Hessian approximation interface (docs/design.md, "the one idea").
  *
  * Every solver is an outer method (solvers/outer_method.h) combined with an
  * InvApprox: something that is set up from the step's BC-projected Hessian

@@ -1,4 +1,4 @@
-/* Line-search strategies an outer method is handed (DESIGN "the one idea";
+/* Line-search strategies an outer method is handed (docs/design.md, "the one idea";
  * SPEC 5): chosen by the solver option `linesearch=NAME`, never a code path
  * inside a method: "halving" (the reference rule, SPEC 5), "armijo" and
  * "wolfe" (strong Wolfe conditions, Nocedal & Wright Alg. 3.5/3.6, as Gast

@@ -1,4 +1,4 @@
-/* The outer-method interface (DESIGN "the one idea"): projected Newton,
+/* The outer-method interface (docs/design.md, "the one idea"): projected Newton,
  * L-BFGS, ... as objects with an ops table and a private context, registered
  * by name in experiments/run/registry.c like the inverse approximations.
  *

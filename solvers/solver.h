@@ -1,5 +1,5 @@
 /* A solver = an outer method x an inverse approximation x strategies x
- * options (DESIGN "the one idea"). This file composes and runs the parts;
+ * options (docs/design.md, "the one idea"). This file composes and runs the parts;
  * which parts exist by name is experiments/run/registry.c's business (the only
  * file that knows every implementation), so solvers/ knows no adapter. */
 #ifndef MPM_SOLVER_H

@@ -1,4 +1,4 @@
-/* Stopping rules an outer method is handed (DESIGN "the one idea"), chosen
+/* Stopping rules an outer method is handed (docs/design.md, "the one idea"), chosen
  * by the solver option `stop=NAME`:
  *  - "cn": the node-wise characteristic norm of SPEC 4 (HOT §5.2), s < eps
  *    with eps the run's --eps: the shared rule of the study;

@@ -2,7 +2,7 @@
  * independent of the number of OpenMP threads).
  *
  * - "poisson": blue-noise (Poisson-disk) samples cut from a periodic tile,
- *   as the HOT reference does (reference/hot-scenes.md section 1.5). The tile
+ *   as the HOT reference does (docs/scenes.md §4, hot-scenes.md section 1.5). The tile
  *   is generated once per seed with Bridson's algorithm (Bridson, "Fast
  *   Poisson disk sampling in arbitrary dimensions", SIGGRAPH 2007 sketches)
  *   made periodic, with unit minimum distance; it is anchored at the world
@@ -29,7 +29,7 @@
 #include "core/scene/shape.h"
 
 /* Realised samples per dx^3 per unit ppc of the "poisson" and "random"
- * samplers (HOT: 0.864-0.871 over eight scenes, reference/hot-scenes.md). */
+ * samplers (HOT: 0.864-0.871 over eight scenes, docs/scenes.md §4, hot-scenes.md). */
 #define SAMPLER_DENSITY 0.868
 
 typedef enum { SAMPLING_POISSON = 0, SAMPLING_RANDOM = 1, SAMPLING_LATTICE = 2 } SamplingKind;

@@ -1,5 +1,5 @@
 /* The registry: which outer methods, inverse approximations and named
- * presets exist (DESIGN floor 4: the only file that knows every
+ * presets exist (docs/design.md, floor 4: the only file that knows every
  * implementation, adapters included). It is data: one line per part, one
  * line per preset.
  *

@@ -1,4 +1,4 @@
-/* Conformance of every registered solver part (DESIGN "the one idea"; in the
+/* Conformance of every registered solver part (docs/design.md, "the one idea"; in the
  * spirit of SUNDIALS' test_sunlinsol): the loops run over the registry, so a
  * newly registered inverse approximation, outer method or preset is checked
  * without touching this file.
