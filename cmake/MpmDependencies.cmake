@@ -32,6 +32,24 @@ find_library(HYPRE_LIBRARY NAMES HYPRE)
 mpm_require(HYPRE_INCLUDE_DIR "hypre headers" "libhypre-dev")
 mpm_require(HYPRE_LIBRARY "hypre" "libhypre-dev")
 
+# Trilinos ML (adapters/ml.c: the ml inverse approximation, presets pn-ml-pcg
+# and lbfgs-ml): optional, on when found.
+find_path(ML_INCLUDE_DIR ml_include.h PATH_SUFFIXES trilinos)
+find_library(ML_LIBRARY trilinos_ml)
+if(ML_INCLUDE_DIR AND ML_LIBRARY)
+  set(MPM_ML_FOUND ON)
+else()
+  set(MPM_ML_FOUND OFF)
+endif()
+option(MPM_WITH_ML "Build the Trilinos ML adapter (presets pn-ml-pcg, lbfgs-ml)" ${MPM_ML_FOUND})
+if(MPM_WITH_ML)
+  mpm_require(ML_INCLUDE_DIR "Trilinos ML headers (MPM_WITH_ML=ON)" "libtrilinos-ml-dev")
+  mpm_require(ML_LIBRARY "Trilinos ML (MPM_WITH_ML=ON)" "libtrilinos-ml-dev")
+elseif(NOT MPM_ML_FOUND)
+  message(STATUS "Trilinos ML not found: building without the ml presets (install the Debian package "
+                 "'libtrilinos-ml-dev' or run scripts/setup.sh to get them)")
+endif()
+
 find_package(PNG)
 mpm_require(PNG_FOUND "libpng" "libpng-dev")
 
@@ -40,4 +58,9 @@ target_include_directories(mpm_deps INTERFACE ${JANSSON_INCLUDE_DIR} ${CHOLMOD_I
                            ${HYPRE_INCLUDE_DIR})
 target_link_libraries(mpm_deps INTERFACE OpenMP::OpenMP_C MPI::MPI_C GSL::gsl
                       ${JANSSON_LIBRARY} ${CHOLMOD_LIBRARY} ${HYPRE_LIBRARY} PNG::PNG)
+if(MPM_WITH_ML)
+  target_include_directories(mpm_deps INTERFACE ${ML_INCLUDE_DIR})
+  target_link_libraries(mpm_deps INTERFACE ${ML_LIBRARY})
+  target_compile_definitions(mpm_deps INTERFACE MPM_WITH_ML=1)
+endif()
 add_library(MPM::deps ALIAS mpm_deps)

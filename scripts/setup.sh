@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 
 # what building and running need (python3-matplotlib: `matrix report`'s
 # figures); what only testing needs is installed by scripts/test.sh
-packages=(build-essential cmake pkg-config python3 python3-matplotlib libhypre-dev libsuitesparse-dev libgsl-dev
+packages=(build-essential cmake pkg-config python3 python3-matplotlib libhypre-dev libtrilinos-ml-dev libsuitesparse-dev libgsl-dev
           libopenmpi-dev openmpi-bin libjansson-dev libpng-dev libopenblas0)
 missing=()
 for p in "${packages[@]}"; do

@@ -12,6 +12,9 @@
 
 #include "adapters/cholmod.h"
 #include "adapters/boomeramg.h"
+#ifdef MPM_WITH_ML
+#include "adapters/ml.h"
+#endif
 #include "mpm_build_info.h" /* generated at build time: MPM_GIT_COMMIT, MPM_GIT_DIRTY */
 
 #ifndef MPM_BUILD_FLAGS
@@ -135,6 +138,9 @@ json_t *provenance_json(int threads, int with_checkout)
                               MPM_BUILD_TYPE);
     json_t *libs = json_pack("{s:s, s:s, s:s, s:s, s:s}", "hypre", boomeramg_library_version(), "cholmod",
                              cholmod_library_version(), "openblas", openblas, "mpi", mpi, "jansson", jansson);
+#ifdef MPM_WITH_ML
+    if (libs) json_object_set_new(libs, "trilinos_ml", json_string(ml_library_version()));
+#endif
     json_t *envs = json_pack("{s:s, s:s, s:s, s:s}", "OMP_WAIT_POLICY", env_or_empty("OMP_WAIT_POLICY"),
                              "OMP_NUM_THREADS", env_or_empty("OMP_NUM_THREADS"), "OMP_PROC_BIND",
                              env_or_empty("OMP_PROC_BIND"), "OMP_PLACES", env_or_empty("OMP_PLACES"));

@@ -15,7 +15,13 @@
     X(outer_gast15)      \
     X(outer_semi_implicit)
 
-/* Inverse approximations: one line each (solvers/, adapters/). */
+/* Inverse approximations: one line each (solvers/, adapters/). Optional
+ * libraries register only when built in (CMake option MPM_WITH_ML). */
+#ifdef MPM_WITH_ML
+#define ML_INVERSE(X) X(inv_ml_ops)
+#else
+#define ML_INVERSE(X)
+#endif
 #define INVERSE_APPROXIMATIONS(X) \
     X(inv_block_jacobi_ops)       \
     X(inv_scalar_jacobi_ops)      \
@@ -24,6 +30,7 @@
     X(inv_inexact_pcg_ops)        \
     X(inv_cholmod_ops)            \
     X(inv_boomeramg_ops)          \
+    ML_INVERSE(X)                 \
     X(inv_gast_diagonal_ops)
 
 #define DECLARE_OUTER(sym) extern const OuterMethodOps sym;
@@ -48,6 +55,10 @@ static const SolverPreset g_presets[] = {
      "pn", "mg", ""},
     {"pn-amg-pcg", "projected Newton, PCG preconditioned by one hypre BoomerAMG V-cycle (algebraic baseline)", "pn",
      "boomeramg", ""},
+#ifdef MPM_WITH_ML
+    {"pn-ml-pcg", "projected Newton, PCG preconditioned by one Trilinos ML smoothed-aggregation V-cycle (algebraic "
+     "baseline)", "pn", "ml", ""},
+#endif
     {"pn-cholmod", "projected Newton with exact CHOLMOD Cholesky solves (exact-Newton reference)", "pn", "cholmod", ""},
     {"hot", "L-BFGS, initial inverse = one linear-embedding Galerkin multigrid V-cycle built once per step (HOT)",
      "lbfgs", "mg", ""},
@@ -61,6 +72,9 @@ static const SolverPreset g_presets[] = {
     {"lbfgs-h-direct", "L-BFGS, initial inverse = CHOLMOD factor of the start-of-step Hessian (Li et al. 2019)", "lbfgs",
      "cholmod", ""},
     {"lbfgs-amg", "L-BFGS, initial inverse = one hypre BoomerAMG V-cycle", "lbfgs", "boomeramg", ""},
+#ifdef MPM_WITH_ML
+    {"lbfgs-ml", "L-BFGS, initial inverse = one Trilinos ML smoothed-aggregation V-cycle", "lbfgs", "ml", ""},
+#endif
     {"gast15", "Gast et al. 2015: unprojected Newton, CG stopping at indefiniteness, strong Wolfe, ||g|| < 1e-3, "
      "rest-configuration diagonal preconditioner, matrix-free", "gast15", "gast-diagonal", "linesearch=wolfe,stop=l2"},
     {"gast15-hot", "what the HOT study ran as Gast15: matrix-free projected Newton, block Jacobi, halving, ||g|| < 1e-3, "
