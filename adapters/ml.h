@@ -28,6 +28,11 @@
  *   ml_rbm          on (default) | off: the 6 rigid-body modes, or only the
  *                   3 translations (ML's default null space)
  *
+ * Failure modes: ML does not report a failed KLU factorisation of the
+ * coarsest level to the caller; Amesos writes the matrix to
+ * amesos-failure.dat in the working folder instead. The coarsest Galerkin
+ * matrix of an SPD Hessian is SPD, so this is seen only with a wrong matrix.
+ *
  * MPI: ML is built with MPI. The adapter calls MPI_Init(NULL, NULL) at
  * start-up when the program has not initialised MPI (and MPI_Finalize at
  * exit when it was the one), as the hypre adapter does; whichever starts
