@@ -9,7 +9,7 @@
 #include <sys/stat.h>
 
 #include "core/error.h"
-#include "core/scene.h"
+#include "core/scene/scene_load.h"
 #include "experiments/accuracy/error_ref.h"
 #include "experiments/run/registry.h"
 

@@ -11,7 +11,7 @@
 
 #include "core/error.h"
 #include "core/scene/sampler.h"
-#include "core/scene.h"
+#include "core/scene/scene_load.h"
 #include "tests/common/testutil.h"
 
 #ifndef M_PI

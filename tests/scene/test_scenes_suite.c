@@ -16,9 +16,10 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "core/collider.h"
+#include "core/scene/collider_load.h"
 #include "core/error.h"
-#include "core/scene.h"
+#include "core/scene/sampler.h"
+#include "core/scene/scene_load.h"
 #include "core/source.h"
 #include "core/step.h"
 #include "tests/common/testutil.h"

@@ -18,6 +18,7 @@
 
 #include "core/error.h"
 #include "core/step.h"
+#include "core/scene/scene_load.h"
 #include "experiments/accuracy/error_ref.h"
 #include "experiments/run/library_startup.h"
 #include "experiments/run/registry.h"
