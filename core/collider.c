@@ -10,16 +10,11 @@
 #include "core/collider.h"
 
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
 #include "core/mat3.h"
-
-#ifndef M_PI
-#define M_PI 3.14159265358979323846
-#endif
 
 /* Index of the phase containing time t (phases cover [0, inf); t < 0 maps
  * to the first). */
