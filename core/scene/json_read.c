@@ -116,7 +116,7 @@ int sj_check_object(json_t *obj, const char *file, const char *path, const char 
                 used += (size_t)w;
             }
             sj_path(p, sizeof p, path, key);
-            return mpm_error(MPM_EINPUT, "%s: %s: unknown field (expected one of: %s)", file, p, list);
+            return mpm_error(MPM_EINPUT, "%s: %s: unknown key (known: %s)", file, p, list);
         }
     }
     return MPM_OK;
