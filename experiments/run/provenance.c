@@ -10,9 +10,17 @@
 #include <time.h>
 #include <unistd.h>
 
+#if MPM_WITH_CHOLMOD
 #include "adapters/cholmod.h"
+#else
+static const char *cholmod_library_version(void) { return "not built"; }
+#endif
+#if MPM_WITH_HYPRE
 #include "adapters/boomeramg.h"
-#ifdef MPM_WITH_ML
+#else
+static const char *boomeramg_library_version(void) { return "not built"; }
+#endif
+#if MPM_WITH_ML
 #include "adapters/ml.h"
 #endif
 #include "mpm_build_info.h" /* generated at build time: MPM_GIT_COMMIT, MPM_GIT_DIRTY */
@@ -138,7 +146,7 @@ json_t *provenance_json(int threads, int with_checkout)
                               MPM_BUILD_TYPE);
     json_t *libs = json_pack("{s:s, s:s, s:s, s:s, s:s}", "hypre", boomeramg_library_version(), "cholmod",
                              cholmod_library_version(), "openblas", openblas, "mpi", mpi, "jansson", jansson);
-#ifdef MPM_WITH_ML
+#if MPM_WITH_ML
     if (libs) json_object_set_new(libs, "trilinos_ml", json_string(ml_library_version()));
 #endif
     json_t *envs = json_pack("{s:s, s:s, s:s, s:s}", "OMP_WAIT_POLICY", env_or_empty("OMP_WAIT_POLICY"),

@@ -1,3 +1,4 @@
+/* needs: MPM_WITH_CHOLMOD MPM_WITH_HYPRE */
 /* Third-party adapters (adapters/): CHOLMOD direct factorisation and one
  * hypre BoomerAMG V-cycle as inverse approximations, on synthetic SPD 3x3-
  * block matrices (tests/common/synthetic.h: spring network on a ball of grid nodes,
@@ -23,7 +24,7 @@
 
 #include "adapters/cholmod.h"
 #include "adapters/boomeramg.h"
-#ifdef MPM_WITH_ML
+#if MPM_WITH_ML
 #include "adapters/ml.h"
 #endif
 #include "core/error.h"
@@ -453,7 +454,7 @@ static void test_boomeramg(SynthProblem *p)
     free(Mx);
 }
 
-#ifdef MPM_WITH_ML
+#if MPM_WITH_ML
 static double max_abs_diff(size_t len, const double *a, const double *b, double *amax)
 {
     double d = 0.0, m = 0.0;
@@ -833,7 +834,7 @@ static void test_mpm_hessian(void)
                   rj.iters);
         inv_destroy(M);
     }
-#ifdef MPM_WITH_ML
+#if MPM_WITH_ML
     {
         InvApprox *M = NULL;
         st = inv_create(&inv_ml_ops, NULL, &M);
@@ -878,12 +879,12 @@ int main(void)
     test_cholmod(&p);
     test_cholmod_chain();
     test_boomeramg(&p);
-#ifdef MPM_WITH_ML
+#if MPM_WITH_ML
     test_ml(&p);
 #endif
     synth_free(&p);
     test_mpm_hessian();
-#ifdef MPM_WITH_ML
+#if MPM_WITH_ML
     test_ml_rigid_body_modes();
 #endif
     return test_summary("test_adapters");
