@@ -212,6 +212,11 @@ static int amg_create(SolverOptions *opt, InvApprox **out)
     s->max_levels = (int)max_levels;
     s->base.ops = &inv_boomeramg_ops;
     s->base.caps = INV_NEEDS_MATRIX | INV_SYMMETRIC | INV_POSITIVE;
+#ifndef HYPRE_USING_OPENMP
+    /* hypre's setup and V-cycle run on one thread (the matrix conversion
+     * before them is OpenMP-parallel) */
+    s->base.setup_threads = s->base.apply_threads = 1;
+#endif
     *out = &s->base;
     return MPM_OK;
 }
@@ -453,6 +458,20 @@ static int amg_setup(InvApprox *self, const InvSetupInput *in)
     return MPM_OK;
 }
 
+/* Setup reuse (inverse_approx.h): the hierarchy and its copy of the matrix
+ * are kept as they are, a lagged preconditioner, whatever `values` asks:
+ * hypre 2.26 has no update of a whole hierarchy's values short of a new
+ * BoomerAMGSetup (only its fine-level matrix could be overwritten, which
+ * would leave the smoother and the coarse operators inconsistent). */
+static int amg_reuse(InvApprox *self, const InvSetupInput *in, int values, int *refreshed)
+{
+    Amg *s = (Amg *)self;
+    (void)values;
+    *refreshed = 0;
+    if (!in->H || in->H->n != s->n) return mpm_error(MPM_EINTERNAL, "boomeramg: reused for a different matrix");
+    return MPM_OK;
+}
+
 static int amg_apply(InvApprox *self, const double *r, double *z)
 {
     Amg *s = (Amg *)self;
@@ -538,7 +557,8 @@ static void amg_view(const InvApprox *self, FILE *f, InvView *out)
 const InvApproxOps inv_boomeramg_ops = {"boomeramg", "one hypre BoomerAMG V-cycle (systems AMG, symmetric smoothing)",
                                         amg_create,  amg_setup,
                                         amg_apply,   amg_view,
-                                        amg_destroy, boomeramg_library_startup};
+                                        amg_destroy, boomeramg_library_startup,
+                                        amg_reuse};
 
 /* ---- library start-up and version (header: "Start-up") ---- */
 
