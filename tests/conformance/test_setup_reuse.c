@@ -12,7 +12,9 @@
  *     they change;
  *  5. the counters add up (requests = rebuilds + refreshes + lagged), and
  *     bad option values or reuse of an implementation without a reuse op
- *     are refused with a one-line error. */
+ *     are refused with a one-line error;
+ *  7. BoomerAMG's elasticity options keep its V-cycle symmetric and
+ *     positive, and bad values are refused. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -287,6 +289,39 @@ int main(void)
               "cholmod: symbolic_reuses %ld factorizations %ld analyses %ld", stat_of(M, "symbolic_reuses"),
               stat_of(M, "factorizations"), stat_of(M, "analyses"));
         inv_destroy(M);
+    }
+
+    /* 7. BoomerAMG's elasticity options (adapters/boomeramg.c) keep the
+     * V-cycle symmetric and positive, and PCG converges with each */
+    {
+        const char *variants[] = {"amg_relax=3",     "amg_relax=13",
+                                  "amg_relax=16,amg_cheby_order=3", "amg_relax=18,amg_sweeps=2",
+                                  "amg_rbm=2,amg_rbm_qmax=4", "amg_agg_levels=1,amg_agg_interp=6,amg_agg_pmax=4,amg_num_paths=2",
+                                  "amg_nodal=1,amg_nodal_diag=1,amg_trunc=0.1,amg_interp=14"};
+        for (size_t i = 0; i < sizeof variants / sizeof variants[0]; ++i) {
+            InvApprox *M = create(&inv_boomeramg_ops, variants[i]);
+            if (!M || setup(M, &A2)) continue;
+            symmetric_positive(M, A2.n, &A2.proj, variants[i]);
+            double rr;
+            int it = pcg_iters(&A2, M, &rr);
+            printf("boomeramg %-60s PCG %d iterations\n", variants[i], it);
+            CHECK(it > 0 && it < 60 && rr < 1e-9, "boomeramg %s: PCG %d iterations, residual %.3g", variants[i], it, rr);
+            inv_destroy(M);
+        }
+        const char *bad[] = {"amg_relax=7", "amg_agg_interp=9", "amg_trunc=1.5", "amg_cheby_order=2.5",
+                             "amg_nodal_diag=3", "amg_rbm=1,amg_nodal=0", "amg_num_paths=0", "amg_rbm_qmax=-1"};
+        for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+            SolverOptions o;
+            memset(&o, 0, sizeof o);
+            InvApprox *M = NULL;
+            solver_opts_set_list(&o, bad[i], "test");
+            mpm_clear_error();
+            st = inv_create(&inv_boomeramg_ops, &o, &M);
+            CHECK(st == MPM_EINPUT && strstr(mpm_last_error(), "--solver-opt amg_") && !strchr(mpm_last_error(), '\n'),
+                  "%s: st %d, '%s'", bad[i], st, mpm_last_error());
+            inv_destroy(M);
+        }
+        mpm_clear_error();
     }
 
     /* 6. refused options */
