@@ -131,6 +131,9 @@ static int ml_create(SolverOptions *opt, InvApprox **out)
     s->rbm = r;
     s->base.ops = &inv_ml_ops;
     s->base.caps = INV_NEEDS_MATRIX | INV_SYMMETRIC | INV_POSITIVE;
+    /* ML's set-up runs on one thread; its V-cycle's fine-level products are
+     * the project's OpenMP matvec (the coarse levels are serial) */
+    s->base.setup_threads = 1;
     *out = &s->base;
     return MPM_OK;
 }
@@ -390,4 +393,5 @@ static void ml_view(const InvApprox *self, FILE *f, InvView *out)
 const InvApproxOps inv_ml_ops = {"ml",       "one Trilinos ML smoothed-aggregation V-cycle (elasticity null space)",
                                  ml_create,  ml_setup,
                                  ml_apply,   ml_view,
-                                 ml_destroy, ml_library_startup};
+                                 ml_destroy, ml_library_startup,
+                                 NULL /* no setup reuse: every setup builds a new hierarchy */};
