@@ -1,5 +1,7 @@
-# Finds every third-party dependency and says which Debian package provides a
-# missing one. All of them end up behind the MPM::deps interface target.
+# Finds every third-party dependency, says which Debian package provides a
+# missing one, and gives each an imported target that the floor using it
+# links PRIVATE (docs/design.md, floors). hypre and CHOLMOD are optional:
+# MPM_WITH_HYPRE and MPM_WITH_CHOLMOD are ON when the library is found.
 
 function(mpm_require found what package)
   if(NOT ${found})
@@ -8,6 +10,29 @@ function(mpm_require found what package)
   endif()
 endfunction()
 
+# An imported target NAME for a library found as an include dir and a file.
+function(mpm_library name include_dir library)
+  add_library(${name} INTERFACE IMPORTED)
+  set_target_properties(${name} PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${include_dir}"
+                                           INTERFACE_LINK_LIBRARIES "${library}")
+endfunction()
+
+# option(MPM_WITH_<X>) defaulting to whether the library was found; ON without
+# the library is an error, OFF says which package would turn it on.
+function(mpm_optional option found what package)
+  option(${option} "Build the ${what} adapter (Debian package ${package})" ${${found}})
+  if(${option} AND NOT ${found})
+    message(FATAL_ERROR "${option}=ON but ${what} was not found: install the Debian package '${package}' "
+                        "or configure with -D${option}=OFF")
+  elseif(NOT ${option})
+    message(STATUS "${option}=OFF: the ${what} adapter and its presets are left out "
+                   "(install the Debian package '${package}' and configure with -D${option}=ON)")
+  endif()
+endfunction()
+
+# Required by the core and solvers (OpenMP), the scene loader and the app
+# (jansson), the matrix runner (MPI: a study under mpirun hands cells to
+# ranks) and the renderer (libpng); GSL by the tests only.
 find_package(OpenMP COMPONENTS C)
 mpm_require(OpenMP_C_FOUND "OpenMP for C" "libgomp1 (comes with gcc)")
 
@@ -21,23 +46,28 @@ find_path(JANSSON_INCLUDE_DIR jansson.h)
 find_library(JANSSON_LIBRARY jansson)
 mpm_require(JANSSON_LIBRARY "jansson (JSON)" "libjansson-dev")
 mpm_require(JANSSON_INCLUDE_DIR "jansson headers" "libjansson-dev")
-
-find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse)
-find_library(CHOLMOD_LIBRARY cholmod)
-mpm_require(CHOLMOD_INCLUDE_DIR "CHOLMOD headers" "libsuitesparse-dev")
-mpm_require(CHOLMOD_LIBRARY "CHOLMOD" "libsuitesparse-dev")
-
-find_path(HYPRE_INCLUDE_DIR HYPRE.h PATH_SUFFIXES hypre)
-find_library(HYPRE_LIBRARY NAMES HYPRE)
-mpm_require(HYPRE_INCLUDE_DIR "hypre headers" "libhypre-dev")
-mpm_require(HYPRE_LIBRARY "hypre" "libhypre-dev")
+mpm_library(MPM::jansson ${JANSSON_INCLUDE_DIR} ${JANSSON_LIBRARY})
 
 find_package(PNG)
 mpm_require(PNG_FOUND "libpng" "libpng-dev")
 
-add_library(mpm_deps INTERFACE)
-target_include_directories(mpm_deps INTERFACE ${JANSSON_INCLUDE_DIR} ${CHOLMOD_INCLUDE_DIR}
-                           ${HYPRE_INCLUDE_DIR})
-target_link_libraries(mpm_deps INTERFACE OpenMP::OpenMP_C MPI::MPI_C GSL::gsl
-                      ${JANSSON_LIBRARY} ${CHOLMOD_LIBRARY} ${HYPRE_LIBRARY} PNG::PNG)
-add_library(MPM::deps ALIAS mpm_deps)
+# Optional adapters.
+find_path(HYPRE_INCLUDE_DIR HYPRE.h PATH_SUFFIXES hypre)
+find_library(HYPRE_LIBRARY NAMES HYPRE)
+if(HYPRE_INCLUDE_DIR AND HYPRE_LIBRARY)
+  mpm_library(MPM::hypre ${HYPRE_INCLUDE_DIR} ${HYPRE_LIBRARY})
+  set(MPM_HYPRE_FOUND ON)
+else()
+  set(MPM_HYPRE_FOUND OFF)
+endif()
+mpm_optional(MPM_WITH_HYPRE MPM_HYPRE_FOUND "hypre BoomerAMG" "libhypre-dev")
+
+find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse)
+find_library(CHOLMOD_LIBRARY cholmod)
+if(CHOLMOD_INCLUDE_DIR AND CHOLMOD_LIBRARY)
+  mpm_library(MPM::cholmod ${CHOLMOD_INCLUDE_DIR} ${CHOLMOD_LIBRARY})
+  set(MPM_CHOLMOD_FOUND ON)
+else()
+  set(MPM_CHOLMOD_FOUND OFF)
+endif()
+mpm_optional(MPM_WITH_CHOLMOD MPM_CHOLMOD_FOUND "CHOLMOD" "libsuitesparse-dev")

@@ -2,26 +2,10 @@
  * SourceCollisionObject, docs/scenes.md §4, hot-scenes.md sections 3.6 Boards and
  * 3.9 Sauce).
  *
- * JSON form (an entry of the scene's "sources" array; unknown fields are
- * errors):
- *   {"name": "sand",                    optional, default "source<i>"
- *    "material": "sand",                required, a key of "materials"
- *    "shape": {...},                    required, bounded (HOT: a sphere)
- *    "ppc": 16,                         required, > 0: Poisson samples per dx^3
- *                                       (realised 0.868 ppc, core/scene/sampler.h)
- *    "velocity": [0, -0.5, 0],          required, nonzero: outflow velocity
- *                                       [m/s] in the source's rest frame
- *    "from": 0,                         optional, default 0 [s]
- *    "until": 4.125,                    optional, default forever [s]
- *    "pivot": [..], "motion": [..], "oscillation": {..}
- *                                       optional: the source's rigid motion,
- *                                       exactly as for colliders (collider.h)
- *    "collider": true,                  optional, default true
- *    "particle_volume": "sampled"}      optional: "sampled" (default) or
- *                                       "nominal", see below
+ * The JSON form is in core/scene/source_load.h.
  *
  * Emission (as in the reference): the shape's rest-frame bounds are filled
- * with samples of the scene's periodic Poisson tile at the source's ppc. At
+ * (by the loader) with samples of the scene's periodic Poisson tile at the source's ppc. At
  * time t every sample is displaced by D(t) = velocity (t - from), wrapping
  * periodically along each axis the velocity moves; the wrap period is a
  * whole number of tile periods, so the moving pattern stays blue noise
@@ -61,13 +45,11 @@
 #ifndef MPM_SOURCE_H
 #define MPM_SOURCE_H
 
-#include <jansson.h>
 #include <stddef.h>
 
 #include "core/collider.h"
 #include "core/material.h"
 #include "core/particles.h"
-#include "core/scene/sampler.h"
 
 typedef struct Source {
     char name[64];
@@ -83,14 +65,6 @@ typedef struct Source {
     double box_lo[3], period[3]; /* wrap box on those axes */
     int has_collider;
 } Source;
-
-/* Parses one source (`jpath` e.g. "sources.0" names it in messages).
- * `default_name` names an unnamed source. `tile` is the scene's Poisson
- * tile. When the source has a collider, *collider receives it (else it is
- * zeroed). On failure nothing is left to free. */
-int source_parse(json_t *j, const char *file, const char *jpath, const char *asset_dir, double dx,
-                 const Material *mats, int n_mats, const PoissonTile *tile, const char *default_name,
-                 Source *out, Collider *collider);
 
 /* 1 if a step beginning at t0 emits (from <= t0 < until, see above). */
 int source_active(const Source *s, double t0);

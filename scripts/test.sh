@@ -3,10 +3,12 @@
 #   0. setup (scripts/setup.sh: packages + build/) and the packages only
 #      testing needs (installed here when missing);
 #   1. the whole CTest suite on the release build;
-#   2. the unit tests again in an ASan + UBSan build (build-asan: any
+#   2. the minimal build (build-minimal: no hypre, no CHOLMOD) and its unit
+#      and conformance tests;
+#   3. the unit tests again in an ASan + UBSan build (build-asan: any
 #      address error, leak or undefined behaviour fails the test);
-#   3. each libFuzzer target for MPM_FUZZ_SECONDS (default 60) seconds;
-#   4. valgrind (memcheck, leaks) on a short run that exercises a solver.
+#   4. each libFuzzer target for MPM_FUZZ_SECONDS (default 60) seconds;
+#   5. valgrind (memcheck, leaks) on a short run that exercises a solver.
 # `bash scripts/test.sh --quick` runs steps 0 and 1 only (the release suite);
 # so does MPM_QUICK=1. Other arguments go to the first ctest.
 set -euo pipefail
@@ -16,7 +18,7 @@ if [ "${1:-}" = --quick ]; then quick=1; shift; fi
 bash scripts/setup.sh
 
 # packages only testing needs: clang + its sanitizer runtime + libomp (the
-# fuzz build), valgrind (step 4), python3-jsonschema (tests/matrix/
+# fuzz build), valgrind (step 5), python3-jsonschema (tests/matrix/
 # test_matrix_schema.sh validates the matrix files against
 # docs/matrix.schema.json), python3-vtk9 (tests/cli/test_vtk.sh reads the
 # ParaView output back with VTK's reader)
@@ -38,7 +40,23 @@ ctest --test-dir build --output-on-failure -j2 "$@"
 echo "test.sh: release suite $((SECONDS - t0)) s" >&2
 [ "$quick" = 1 ] && exit 0
 
-# --- 2. sanitizers ---------------------------------------------------------
+# --- 2. minimal build --------------------------------------------------------
+# every optional adapter OFF (docs/design.md, floors): the in-house presets
+# and their tests must not need them (tests that do are not registered)
+t0=$SECONDS
+if [ ! -f build-minimal/CMakeCache.txt ]; then
+  cmake -S . -B build-minimal -DCMAKE_BUILD_TYPE=Release -DMPM_WITH_HYPRE=OFF -DMPM_WITH_CHOLMOD=OFF >/dev/null
+fi
+log=build-minimal/build.log
+if ! nice -n 5 cmake --build build-minimal -j"$(nproc)" -- --no-print-directory >"$log" 2>&1; then
+  cat "$log" >&2
+  echo "test.sh: minimal build failed (log: $log)" >&2
+  exit 1
+fi
+ctest --test-dir build-minimal --output-on-failure -j2 -L "unit|conformance"
+echo "test.sh: minimal build and its unit + conformance tests $((SECONDS - t0)) s" >&2
+
+# --- 3. sanitizers ---------------------------------------------------------
 # Tests too slow under ASan for CI's budget are listed here (and printed),
 # never dropped silently; they still run in step 1.
 asan_skip=${MPM_ASAN_SKIP-"test_solvers|test_solvers_mls|test_mg_scene"} # 385 s and 141 s alone under ASan (release: 52 s, 32 s;
@@ -48,7 +66,7 @@ t0=$SECONDS
 # the default compiler (gcc): a clang build with libFuzzer's coverage
 # instrumentation runs these tests 2-3x slower, and libomp leaks its thread
 # teams when the thread count changes (test_robust), so the fuzz targets of
-# step 3 get their own build (build-fuzz)
+# step 4 get their own build (build-fuzz)
 if [ ! -f build-asan/CMakeCache.txt ]; then
   cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMPM_SANITIZE=ON >/dev/null
 fi
@@ -67,12 +85,12 @@ echo "test.sh: ASan+UBSan unit tests (not run under ASan, too slow for CI: ${asa
 ctest --test-dir build-asan --output-on-failure -j2 -E "^(${asan_skip:-none}|test_cli|test_render_cmd|test_scenes_run|test_summarize|test_docs_solvers|test_fill_numbers|test_matrix_schema)\$"
 echo "test.sh: sanitizer suite $((SECONDS - t0)) s" >&2
 
-# --- 3. fuzzing ------------------------------------------------------------
+# --- 4. fuzzing ------------------------------------------------------------
 t0=$SECONDS
 bash scripts/fuzz.sh all "${MPM_FUZZ_SECONDS:-60}"
 echo "test.sh: fuzzing $((SECONDS - t0)) s" >&2
 
-# --- 4. valgrind -------------------------------------------------------------
+# --- 5. valgrind -------------------------------------------------------------
 # bar3's stiff middle at a coarse scale: a few Newton and PCG iterations per
 # step, one thread (OpenMP's thread pool is not what is under test)
 t0=$SECONDS

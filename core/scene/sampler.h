@@ -74,7 +74,7 @@ int sampler_sample(const Shape *shape, SamplingKind kind, double dx, double ppc,
  * of the surface, projected onto phi = 0 along the gradient (Newton steps
  * on phi, |phi| <= 1e-3 h at the end). Deterministic for a seed and any
  * thread count. Appends to *out (min_dist is left unchanged). The scene uses
- * it to stand in for the reference's mesh-vertex particles (scene.h,
+ * it to stand in for the reference's mesh-vertex particles (scene_load.h,
  * "surface_particles"); h = dx / 4 there. */
 int sampler_surface(const Shape *shape, size_t n, double h, uint64_t seed, SamplePoints *out);
 

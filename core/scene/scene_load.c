@@ -1,8 +1,8 @@
-/* Scene loading and validation (format in scene.h). */
+/* Scene loading and validation (format in scene_load.h). */
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L
 #endif
-#include "core/scene.h"
+#include "core/scene/scene_load.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -16,10 +16,13 @@
 
 #include "core/error.h"
 #include "core/mat3.h"
+#include "core/scene/collider_load.h"
+#include "core/scene/json_read.h"
 #include "core/scene/noise.h"
 #include "core/scene/rng.h"
 #include "core/scene/sampler.h"
-#include "core/source.h"
+#include "core/scene/shape.h"
+#include "core/scene/source_load.h"
 
 #ifndef MPM_SCENE_DIR
 #define MPM_SCENE_DIR "experiments/scenes"
@@ -888,7 +891,7 @@ static int parse_sources(Scene *sc, json_t *srcs, const char *file, const char *
         if (s->has_collider) sc->colliders[sc->n_colliders++] = col;
         /* the source must start inside the domain */
         double lo[3], hi[3], R[9], b[3];
-        shape_bounds(s->pose.shape, lo, hi);
+        level_set_bounds(&s->pose.shape, lo, hi);
         collider_pose(&s->pose, 0.0, R, b);
         for (int c = 0; c < 8 && !st; ++c) {
             double X[3], d[3], x[3];

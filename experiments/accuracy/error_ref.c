@@ -17,7 +17,7 @@ struct ErrorRef {
     char spec[160];
     char describe[256];
     int is_auto;
-    Solver *exact;       /* "auto": pn-cholmod */
+    Solver *exact;       /* "auto": pn-cholmod (NULL in a build without CHOLMOD) */
     Solver *fallback;    /* "auto": pn-pcg; otherwise the one reference */
     char exact_name[32], fallback_name[160];
     SolveSettings set;
@@ -70,7 +70,8 @@ int error_ref_check(const char *spec)
     set.eps = eps;
     if ((st = solve_settings_check(&set))) return wrap(st, spec);
     if (!strcmp(solver, "auto")) {
-        if ((st = solver_spec_check(AUTO_EXACT, NULL, 0)) || (st = solver_spec_check(AUTO_FALLBACK, NULL, 0)))
+        if ((registry_find_preset(AUTO_EXACT) && (st = solver_spec_check(AUTO_EXACT, NULL, 0))) ||
+            (st = solver_spec_check(AUTO_FALLBACK, NULL, 0)))
             return wrap(st, spec);
         return MPM_OK;
     }
@@ -94,7 +95,7 @@ int error_ref_create(const char *spec, ErrorRef **out)
     r->is_auto = !strcmp(solver, "auto");
     snprintf(r->fallback_name, sizeof r->fallback_name, "%s", r->is_auto ? AUTO_FALLBACK : solver);
     st = solver_from_spec(r->fallback_name, NULL, 0, &r->fallback);
-    if (!st && r->is_auto) {
+    if (!st && r->is_auto && registry_find_preset(AUTO_EXACT)) {
         snprintf(r->exact_name, sizeof r->exact_name, "%s", AUTO_EXACT);
         st = solver_from_spec(AUTO_EXACT, NULL, 0, &r->exact);
     }
@@ -102,7 +103,10 @@ int error_ref_create(const char *spec, ErrorRef **out)
         error_ref_destroy(r);
         return wrap(st, spec);
     }
-    if (r->is_auto)
+    if (r->is_auto && !r->exact)
+        snprintf(r->describe, sizeof r->describe, "auto: %s (this build has no %s), eps %g", AUTO_FALLBACK,
+                 AUTO_EXACT, eps);
+    else if (r->is_auto)
         snprintf(r->describe, sizeof r->describe, "auto: %s where its factor fits %.0f%% of the memory, else %s; eps %g",
                  AUTO_EXACT, 100 * ERROR_REF_MEMORY_FRACTION, AUTO_FALLBACK, eps);
     else
@@ -173,7 +177,7 @@ int error_ref_measure(void *ctx, StepProblem *pb, const double *dv)
     if (st) return st;
     size_t len = 3 * (size_t)n;
     Solver *ref = r->fallback;
-    if (r->is_auto && error_ref_cholmod_fits(n)) ref = r->exact;
+    if (r->is_auto && r->exact && error_ref_cholmod_fits(n)) ref = r->exact;
     r->last.ref_solver = ref == r->exact ? r->exact_name : r->fallback_name;
     problem_initial_guess(pb, r->dv0);
     vec_copy(len, r->dv0, r->dvs);

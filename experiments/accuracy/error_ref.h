@@ -16,7 +16,8 @@
  * (exact Newton) at the steps whose factor fits the memory budget and
  * pn-pcg at the others (error_ref_cholmod_fits), and at a step whose
  * CHOLMOD factorisation breaks down (one line on stderr says so), each step
- * saying which in steps.csv's ref_solver. Against a reference that failed
+ * saying which in steps.csv's ref_solver (a build without CHOLMOD takes
+ * pn-pcg at every step). Against a reference that failed
  * the metrics are empty (ref_status failed). The reference solve and the metrics run inside
  * run_step's after-solve hook, whose time goes to no timing column (it is
  * ref_s); the problem's iterate cache is left at dv afterwards. */

@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "core/step.h"
 #include "core/transfer.h"
+#include "core/scene/scene_load.h"
 #include "core/transfer_blocked.h"
 #include "experiments/bench/machine_limits.h"
 

@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "core/error.h"
-#include "core/scene.h"
+#include "core/scene/scene_load.h"
 #include "core/threads.h"
 #include "experiments/bench/bench.h"
 #include "experiments/cli/run_settings.h"

@@ -9,7 +9,8 @@
 #include <sys/stat.h>
 
 #include "core/error.h"
-#include "core/scene.h"
+#include "core/scene/json_read.h"
+#include "core/scene/scene_load.h"
 #include "experiments/accuracy/error_ref.h"
 #include "experiments/run/registry.h"
 
@@ -26,48 +27,18 @@ void matrix_format_number(double v, char *out, size_t n)
     }
 }
 
-/* The value as compact JSON text, shortened, for messages. */
-static void value_text(json_t *v, char *out, size_t n)
-{
-    char *s = v ? json_dumps(v, JSON_ENCODE_ANY | JSON_COMPACT) : NULL;
-    if (!s) {
-        snprintf(out, n, "%s", v ? "?" : "nothing");
-        return;
-    }
-    if (strlen(s) + 1 > n && n > 4) snprintf(out, n, "%.*s...", (int)(n - 4), s);
-    else snprintf(out, n, "%s", s);
-    free(s);
-}
-
+/* Messages and key checks are the scene loader's (core/scene/json_read.h),
+ * so a matrix file and a scene file report a bad value the same way. */
 static int bad_value(const Matrix *m, const char *path, json_t *v, const char *expected)
 {
-    char t[96];
-    value_text(v, t, sizeof t);
-    return mpm_error(MPM_EINPUT, "%s: %s: expected %s, got %s", m->base, path, expected, t);
+    char want[300]; /* expected + the longest message text a caller passes */
+    snprintf(want, sizeof want, "expected %s", expected);
+    return sj_bad(m->base, path, NULL, want, v);
 }
 
-/* Every key of obj must be in `known` (NULL-terminated). */
 static int check_keys(const Matrix *m, json_t *obj, const char *path, const char *const *known)
 {
-    const char *key;
-    json_t *v;
-    json_object_foreach(obj, key, v) {
-        int ok = 0;
-        for (int i = 0; known[i] && !ok; ++i) ok = strcmp(key, known[i]) == 0;
-        if (ok) continue;
-        char list[512] = "";
-        size_t len = 0;
-        for (int i = 0; known[i] && len < sizeof list; ++i)
-            len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", i ? ", " : "", known[i]);
-        return mpm_error(MPM_EINPUT, "%s: %s%s%s: unknown key (known: %s)", m->base, path, path[0] ? "." : "", key,
-                         list);
-    }
-    return MPM_OK;
-}
-
-static void join_path(char *out, size_t n, const char *base, const char *key)
-{
-    snprintf(out, n, "%s%s%s", base, base[0] ? "." : "", key);
+    return sj_check_object(obj, m->base, path, known);
 }
 
 static int get_positive(const Matrix *m, json_t *v, const char *path, double *out)
@@ -238,7 +209,7 @@ static int get_kv(const Matrix *m, json_t *obj, const char *path, MatrixNamedKin
     json_t *v;
     json_object_foreach(obj, key, v) {
         char p[256], text[256];
-        join_path(p, sizeof p, path, key);
+        sj_path(p, sizeof p, path, key);
         if (!key[0] || strlen(key) >= key_cap || strchr(key, '=') || strchr(key, ','))
             return mpm_error(MPM_EINPUT, "%s: %s: bad key \"%s\" (non-empty, under %zu characters, no '=' or ',')",
                              m->base, path, key, key_cap);
@@ -295,18 +266,18 @@ static int get_reference(Matrix *m, json_t *v, const char *path, int allow_false
     if (st) return st;
     char p[300];
     json_t *s = json_object_get(v, "solver");
-    join_path(p, sizeof p, path, "solver");
+    sj_path(p, sizeof p, path, "solver");
     if (!s) return mpm_error(MPM_EINPUT, "%s: %s: missing (required)", m->base, p);
     if ((st = get_solver(m, s, p, &r->solver)) || (st = keep(m, p, &r->solver_origin))) return st;
     r->eps = 1e-10;
     json_t *e = json_object_get(v, "eps");
-    join_path(p, sizeof p, path, "eps");
+    sj_path(p, sizeof p, path, "eps");
     if (e && (st = get_positive(m, e, p, &r->eps))) return st;
     json_t *o = json_object_get(v, "solver_opts");
-    join_path(p, sizeof p, path, "solver_opts");
+    sj_path(p, sizeof p, path, "solver_opts");
     if (o && (st = get_kv(m, o, p, MATRIX_SOLVER_OPTS, &r->solver_opts))) return st;
     json_t *sv = json_object_get(v, "set");
-    join_path(p, sizeof p, path, "set");
+    sj_path(p, sizeof p, path, "set");
     if (sv && (st = get_kv(m, sv, p, MATRIX_SET, &r->set))) return st;
     r->has = 1;
     return MPM_OK;
@@ -338,7 +309,7 @@ static int get_settings(Matrix *m, json_t *obj, const char *path, int per_scene,
     json_t *v;
     json_object_foreach(obj, key, v) {
         char p[256];
-        join_path(p, sizeof p, path, key);
+        sj_path(p, sizeof p, path, key);
         int k = run_setting_index(key);
         if (k >= 0 && run_settings[k].type == OPT_LIST) {
             st = get_kv(m, v, p, run_settings[k].flags & OPT_KEY_JSON ? MATRIX_SET : MATRIX_SOLVER_OPTS,
@@ -362,7 +333,7 @@ static int get_settings(Matrix *m, json_t *obj, const char *path, int per_scene,
     int kf = run_setting_index("frames");
     if ((s->given >> kf & 1) && s->has_first && s->first_timed_frame >= s->run.frames) {
         char p[256];
-        join_path(p, sizeof p, path, "first_timed_frame");
+        sj_path(p, sizeof p, path, "first_timed_frame");
         return bad_value(m, p, json_object_get(obj, "first_timed_frame"), "a frame before \"frames\"");
     }
     return MPM_OK;
@@ -415,7 +386,7 @@ static int get_named_axes(Matrix *m, json_t *obj, const char *path, MatrixNamedK
     json_t *axis;
     json_object_foreach(obj, name, axis) {
         char ap[256];
-        join_path(ap, sizeof ap, path, name);
+        sj_path(ap, sizeof ap, path, name);
         int st = check_axis_name(m, path, name);
         if (st) return st;
         if (m->n_named >= MATRIX_MAX_AXES)

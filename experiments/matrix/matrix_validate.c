@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "core/error.h"
-#include "core/scene.h"
+#include "core/scene/scene_load.h"
 #include "experiments/run/registry.h"
 #include "experiments/run/run.h"
 #include "solvers/solver.h"

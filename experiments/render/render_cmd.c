@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "core/threads.h"
 #include "core/step.h"
+#include "core/scene/scene_load.h"
 #include "experiments/cli/run_settings.h"
 #include "experiments/run/frame_driver.h"
 #include "experiments/run/registry.h"
@@ -72,7 +73,7 @@ static int is_domain_wall(const Collider *c)
 {
     static const char *const names[] = {"wall_x_min", "wall_x_max", "wall_y_min",
                                         "wall_y_max", "wall_z_min", "wall_z_max"};
-    if (strcmp(shape_type_name(c->shape), "half_space")) return 0;
+    if (strcmp(level_set_type_name(&c->shape), "half_space")) return 0;
     for (size_t k = 0; k < sizeof names / sizeof names[0]; ++k)
         if (!strcmp(c->name, names[k])) return 1;
     return 0;
@@ -82,7 +83,7 @@ static int is_domain_wall(const Collider *c)
  * whole picture as huge planes: only floors (normal near +-y) are drawn. */
 static int is_side_wall(const Scene *sc, const Collider *c, double t)
 {
-    if (strcmp(shape_type_name(c->shape), "half_space")) return 0;
+    if (strcmp(level_set_type_name(&c->shape), "half_space")) return 0;
     double x[3], n[3] = {0, 1, 0};
     for (int d = 0; d < 3; ++d) x[d] = 0.5 * (sc->domain_lo[d] + sc->domain_hi[d]);
     collider_phi(c, t, x, n);
@@ -155,7 +156,7 @@ static int frame_colliders(const Scene *sc, double t, const int *idx, int n, int
     }
     for (int c = 0; c < n; ++c) {
         const Collider *col = &sc->colliders[idx[c]];
-        int bounded = shape_is_bounded(col->shape);
+        int bounded = level_set_is_bounded(&col->shape);
         if (empty && !bounded) continue;
         double dmin = INFINITY;
 #pragma omp parallel for reduction(min : dmin) schedule(static)

@@ -10,8 +10,16 @@
 #include <time.h>
 #include <unistd.h>
 
+#if MPM_WITH_CHOLMOD
 #include "adapters/cholmod.h"
+#else
+static const char *cholmod_library_version(void) { return "not built"; }
+#endif
+#if MPM_WITH_HYPRE
 #include "adapters/boomeramg.h"
+#else
+static const char *boomeramg_library_version(void) { return "not built"; }
+#endif
 #include "mpm_build_info.h" /* generated at build time: MPM_GIT_COMMIT, MPM_GIT_DIRTY */
 
 #ifndef MPM_BUILD_FLAGS

@@ -15,6 +15,19 @@
     X(outer_gast15)      \
     X(outer_semi_implicit)
 
+/* The adapters are compiled only when their CMake option is ON (the build
+ * defines MPM_WITH_<LIBRARY>=1, docs/design.md, floors). */
+#if MPM_WITH_CHOLMOD
+#define CHOLMOD_INVERSE(X) X(inv_cholmod_ops)
+#else
+#define CHOLMOD_INVERSE(X)
+#endif
+#if MPM_WITH_HYPRE
+#define HYPRE_INVERSE(X) X(inv_boomeramg_ops)
+#else
+#define HYPRE_INVERSE(X)
+#endif
+
 /* Inverse approximations: one line each (solvers/, adapters/). */
 #define INVERSE_APPROXIMATIONS(X) \
     X(inv_block_jacobi_ops)       \
@@ -22,8 +35,8 @@
     X(inv_sgs_ops)                \
     X(inv_mg_ops)                 \
     X(inv_inexact_pcg_ops)        \
-    X(inv_cholmod_ops)            \
-    X(inv_boomeramg_ops)          \
+    CHOLMOD_INVERSE(X)            \
+    HYPRE_INVERSE(X)              \
     X(inv_gast_diagonal_ops)
 
 #define DECLARE_OUTER(sym) extern const OuterMethodOps sym;
@@ -71,13 +84,53 @@ static const SolverPreset g_presets[] = {
 
 #define COUNT(a) ((int)(sizeof(a) / sizeof((a)[0])))
 
-int registry_preset_count(void) { return COUNT(g_presets); }
-const SolverPreset *registry_preset(int i) { return i >= 0 && i < COUNT(g_presets) ? &g_presets[i] : NULL; }
+/* The optional adapters: when one is not built, its presets are absent and
+ * named with the option and package that build it. */
+static const struct {
+    const char *inverse, *option, *package;
+} g_optional[] = {
+    {"boomeramg", "MPM_WITH_HYPRE", "libhypre-dev"},
+    {"cholmod", "MPM_WITH_CHOLMOD", "libsuitesparse-dev"},
+};
+
+/* The g_optional entry of inverse approximation `name` when it is not
+ * built, else -1. */
+static int absent_index(const char *name)
+{
+    if (registry_find_inverse(name)) return -1;
+    for (int i = 0; i < COUNT(g_optional); ++i)
+        if (!strcmp(g_optional[i].inverse, name)) return i;
+    return -1;
+}
+
+static int preset_built(const SolverPreset *p) { return registry_find_inverse(p->inverse) != NULL; }
+
+int registry_preset_count(void)
+{
+    int n = 0;
+    for (int i = 0; i < COUNT(g_presets); ++i) n += preset_built(&g_presets[i]);
+    return n;
+}
+const SolverPreset *registry_preset(int i)
+{
+    for (int k = 0; k < COUNT(g_presets); ++k)
+        if (preset_built(&g_presets[k]) && i-- == 0) return &g_presets[k];
+    return NULL;
+}
 const SolverPreset *registry_find_preset(const char *name)
 {
     for (int i = 0; i < COUNT(g_presets); ++i)
-        if (strcmp(g_presets[i].name, name) == 0) return &g_presets[i];
+        if (strcmp(g_presets[i].name, name) == 0) return preset_built(&g_presets[i]) ? &g_presets[i] : NULL;
     return NULL;
+}
+
+/* "pn-cholmod is not in this build (...)" for an absent preset or inverse. */
+static int not_built(const char *spec, const char *what, const char *inverse)
+{
+    int k = absent_index(inverse);
+    return mpm_error(MPM_EINPUT,
+                     "--solver '%s': %s is not in this build (configure with -D%s=ON; Debian package %s)", spec,
+                     what, g_optional[k].option, g_optional[k].package);
 }
 
 int registry_outer_count(void) { return COUNT(g_outer); }
@@ -135,6 +188,9 @@ int solver_spec_parse(const char *spec, const char *const *opts, int n_opts, Sol
     snprintf(origin, sizeof origin, "--solver '%s'", spec);
     if (!second) {
         const SolverPreset *p = registry_find_preset(first);
+        for (int i = 0; !p && i < COUNT(g_presets); ++i)
+            if (!strcmp(g_presets[i].name, first) && absent_index(g_presets[i].inverse) >= 0)
+                return not_built(spec, first, g_presets[i].inverse);
         if (!p) return mpm_error(MPM_EINPUT, "unknown solver '%s' (see: mpmbench list solvers)", first);
         out->preset = p;
         out->outer = registry_find_outer(p->outer);
@@ -153,6 +209,7 @@ int solver_spec_parse(const char *spec, const char *const *opts, int n_opts, Sol
             return mpm_error(MPM_EINPUT, "--solver '%s': unknown outer method '%s' (registered: %s)", spec, first, known);
         }
         if (!(out->inverse = registry_find_inverse(second))) {
+            if (absent_index(second) >= 0) return not_built(spec, second, second);
             names_of(0, known, sizeof known);
             return mpm_error(MPM_EINPUT, "--solver '%s': unknown inverse approximation '%s' (registered: %s)", spec,
                              second, known);
@@ -189,6 +246,7 @@ void registry_print(FILE *f)
 {
     for (int i = 0; i < COUNT(g_presets); ++i) {
         const SolverPreset *p = &g_presets[i];
+        if (!preset_built(p)) continue;
         fprintf(f, "%-16s %s  [%s:%s%s%s]\n", p->name, p->description, p->outer, p->inverse, p->options[0] ? ":" : "",
                 p->options);
     }
@@ -211,4 +269,14 @@ void registry_print(FILE *f)
     fprintf(f, "\nstopping rules (option stop=NAME, default cn):\n");
     for (int i = 0; i < stop_rule_count(); ++i)
         fprintf(f, "  %-14s %s\n", stop_rule_get(i)->name, stop_rule_get(i)->description);
+    int header = 0;
+    for (int i = 0; i < COUNT(g_optional); ++i) {
+        if (absent_index(g_optional[i].inverse) < 0) continue;
+        if (!header++) fprintf(f, "\nnot in this build (optional adapters):\n");
+        fprintf(f, "  %-14s configure with -D%s=ON (Debian package %s); presets:", g_optional[i].inverse,
+                g_optional[i].option, g_optional[i].package);
+        for (int k = 0; k < COUNT(g_presets); ++k)
+            if (!strcmp(g_presets[k].inverse, g_optional[i].inverse)) fprintf(f, " %s", g_presets[k].name);
+        fprintf(f, "\n");
+    }
 }

@@ -24,6 +24,9 @@ typedef struct {
     const char *options;  /* "key=value,key=value" (overridable) */
 } SolverPreset;
 
+/* The presets of this build: a preset whose inverse approximation is an
+ * adapter left out of the build (MPM_WITH_<LIBRARY>=OFF) is absent; naming
+ * it is an error that says which option builds it. */
 int registry_preset_count(void);
 const SolverPreset *registry_preset(int i);
 const SolverPreset *registry_find_preset(const char *name); /* NULL when unknown */

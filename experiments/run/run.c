@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "core/step.h"
+#include "core/scene/scene_load.h"
 #include "experiments/run/frame_driver.h"
 #include "experiments/run/library_startup.h"
 #include "experiments/run/paths.h"

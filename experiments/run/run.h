@@ -3,7 +3,7 @@
 #ifndef MPM_RUN_H
 #define MPM_RUN_H
 
-#include "core/scene.h"
+#include "core/scene/scene_load.h"
 #include "core/step.h"
 #include "solvers/solver.h"
 

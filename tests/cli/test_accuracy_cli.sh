@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# needs: MPM_WITH_CHOLMOD
 # The accuracy flags of `run` (issue 10, SPEC 11): --trajectory writes
 # trajectory.bin in its documented format; --dt-from replays a run's dt
 # sequence bit for bit; --trajectory-ref against the same run gives exactly

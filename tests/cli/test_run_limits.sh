@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# needs: MPM_WITH_CHOLMOD
 # Robustness of the run loop (issue 12 items 2, 3, 9): a numerical breakdown
 # becomes a step row with status failed and its reason, and the run stops
 # (exit 0) by the default policy; the work per step and per run is bounded

@@ -4,6 +4,7 @@
 
 #include "core/mat3.h"
 #include "core/transfer.h"
+#include "core/scene/scene_load.h"
 #include "tests/common/testutil.h"
 
 void fixture_default(FixtureOptions *o)

@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <unistd.h>
 
-#include "core/scene.h"
+#include "core/scene/scene_load.h"
 
 int g_test_failures = 0, g_test_checks = 0;
 

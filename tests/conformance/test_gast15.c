@@ -1,3 +1,4 @@
+/* needs: MPM_WITH_CHOLMOD */
 /* The Gast et al. 2015 parts (SPEC 8): solvers/outer/gast15.c, the strong Wolfe
  * line search, solvers/inverse/gast_diagonal.c and solvers/outer/semi_implicit.c.
  *

@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/step.h"
+#include "core/scene/scene_load.h"
 #include "experiments/run/registry.h"
 #include "tests/common/testutil.h"
 

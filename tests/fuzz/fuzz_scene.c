@@ -1,4 +1,4 @@
-/* libFuzzer harness: the scene loader (core/scene.h), called directly on a
+/* libFuzzer harness: the scene loader (core/scene/scene_load.h), called directly on a
  * scene file. Every input must give MPM_OK or a one-line MPM_EINPUT /
  * MPM_EINTERNAL message; ASan/UBSan and the leak checker find the rest.
  * The particle budget is small so each input samples in milliseconds, and
@@ -13,7 +13,7 @@
 
 #include "core/error.h"
 #include "core/scene/sampler.h"
-#include "core/scene.h"
+#include "core/scene/scene_load.h"
 #include "tests/fuzz/harness.h"
 
 int LLVMFuzzerInitialize(int *argc, char ***argv)

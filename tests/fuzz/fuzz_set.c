@@ -9,7 +9,7 @@
 
 #include "core/error.h"
 #include "core/scene/sampler.h"
-#include "core/scene.h"
+#include "core/scene/scene_load.h"
 #include "tests/fuzz/harness.h"
 
 static char g_scene[256];

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# needs: MPM_WITH_CHOLMOD
 # Reference runs and the new keys of experiment matrices (issue 10): a
 # "reference" spec gives each scene a reference cell of its own, run first;
 # its dependents get --dt-from/--trajectory-ref with its directory and start

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# needs: MPM_WITH_HYPRE
 # `mpirun -np 2 mpmbench matrix run`: rank 0 hands the cells out to both
 # ranks (itself included) and writes cells.csv; the union of the cells must
 # equal a serial run's, row for row in everything but times. One cell uses

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# needs: MPM_WITH_CHOLMOD
 # The report's accuracy sections (scripts/matrix_report_accuracy.py) on a
 # hand-made result directory with known answers: median err_h over the
 # timed steps only, the last frame's pos_rms, the time to reach err_h <=

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# needs: MPM_WITH_CHOLMOD
 # `mpmbench matrix run`: each cell is a child process whose end becomes its
 # status (ok; crashed: killed by SIGSEGV; timeout: over cell_timeout_s, the
 # child's process group killed; bad-input: its scene file vanished after

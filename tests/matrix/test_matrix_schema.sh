@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# needs: MPM_WITH_CHOLMOD
 # docs/matrix.schema.json describes the matrix-file format the loader
 # accepts: every committed experiments/matrices/*.json validates against it,
 # and on a set of probe files (every key at every level, unknown keys, wrong

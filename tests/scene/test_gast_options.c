@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "core/error.h"
-#include "core/scene.h"
+#include "core/scene/scene_load.h"
 #include "tests/common/testutil.h"
 
 typedef struct {

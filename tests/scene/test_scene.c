@@ -11,7 +11,7 @@
 
 #include "core/error.h"
 #include "core/scene/sampler.h"
-#include "core/scene.h"
+#include "core/scene/scene_load.h"
 #include "tests/common/testutil.h"
 
 #ifndef M_PI
@@ -291,9 +291,9 @@ static void test_bad_input(void)
                "objects.0.shape: particle at", "outside the domain");
     expect_bad("object outside", "\"min\": [0.4, 0.4, 0.4], \"max\": [0.6, 0.6, 0.6]",
                "\"min\": [2.4, 0.4, 0.4], \"max\": [2.6, 0.6, 0.6]", NULL, "objects.0.shape", "outside the domain");
-    expect_bad("typo field", "\"fps\": 24,", "\"fps\": 24, \"fsp\": 3,", NULL, "fsp: unknown field", NULL);
+    expect_bad("typo field", "\"fps\": 24,", "\"fps\": 24, \"fsp\": 3,", NULL, "fsp: unknown key", NULL);
     expect_bad("typo in material", "\"density\": 1000", "\"density\": 1000, \"denisty\": 3", NULL,
-               "materials.soft.denisty: unknown field", NULL);
+               "materials.soft.denisty: unknown key", NULL);
     expect_bad("gravity not vec3", "[0, -9.8, 0]", "[0, -9.8]", NULL, "gravity", NULL);
     expect_bad("bad plasticity", "\"density\": 1000", "\"density\": 1000, \"plasticity\": {\"type\": \"vm\"}", NULL,
                "materials.soft.plasticity.type", "\"vm\"");

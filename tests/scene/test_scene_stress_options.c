@@ -1,4 +1,4 @@
-/* The scene options of the stress suite (core/scene.h): initial_F "diagonal"
+/* The scene options of the stress suite (core/scene/scene_load.h): initial_F "diagonal"
  * and "inverted_fraction", per-object "stiffness_variation" (checkerboard and
  * random), their validation, and particle ids (core/particles.h) surviving
  * the locality sort. */
@@ -8,7 +8,7 @@
 
 #include "core/error.h"
 #include "core/grid.h"
-#include "core/scene.h"
+#include "core/scene/scene_load.h"
 #include "tests/common/testutil.h"
 
 /* A 0.3 m box of soft material, dx 0.02 (about 3.4k particles). */

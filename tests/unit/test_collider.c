@@ -6,7 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "core/collider.h"
+#include "core/scene/collider_load.h"
 #include "core/error.h"
 #include "core/mat3.h"
 #include "tests/common/testutil.h"

@@ -1,3 +1,4 @@
+/* needs: MPM_WITH_CHOLMOD */
 /* Per-step solver error (experiments/accuracy/error_ref.h, SPEC 11):
  *  - the reference against itself gives err_h = e_gap = err_v_max = 0 (< 1e-9);
  *  - on a small bar3 step err_h of pn-pcg does not grow as eps goes 1e-3 ...
@@ -18,6 +19,7 @@
 
 #include "core/error.h"
 #include "core/step.h"
+#include "core/scene/scene_load.h"
 #include "experiments/accuracy/error_ref.h"
 #include "experiments/run/library_startup.h"
 #include "experiments/run/registry.h"

@@ -21,6 +21,7 @@
 #include "core/error.h"
 #include "core/position_update.h"
 #include "core/step.h"
+#include "core/scene/scene_load.h"
 #include "tests/common/fixture.h"
 #include "tests/common/testutil.h"
 

@@ -14,7 +14,7 @@
 #include "core/scene/box_tree.h"
 #include "core/error.h"
 #include "core/reduce.h"
-#include "core/scene.h"
+#include "core/scene/scene_load.h"
 #include "core/step.h"
 #include "core/threads.h"
 #include "core/vec.h"

@@ -25,6 +25,7 @@
 #include "core/scene/noise.h"
 #include "core/plasticity.h"
 #include "core/step.h"
+#include "core/scene/scene_load.h"
 #include "tests/common/testutil.h"
 
 static const char *k_snow =

@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "core/step.h"
+#include "core/scene/scene_load.h"
 #include "tests/common/testutil.h"
 
 static const char *k_cube =
