@@ -83,6 +83,8 @@ typedef struct {
     /* options */
     double strong;
     int coarsen, nodal, agg_levels, interp, pmax, relax, sweeps, rbm, max_levels;
+    int nodal_diag, agg_interp, agg_pmax, num_paths, cheby_order, rbm_qmax;
+    double trunc;
     /* matrix (rebuilt every setup, see build_matrix); NULL = none */
     HYPRE_IJMatrix ij;
     HYPRE_ParCSRMatrix par;
@@ -152,6 +154,19 @@ static int hy_check(HYPRE_Int ierr, const char *what)
     return mpm_error(MPM_EINTERNAL, "boomeramg: %s failed (hypre error %d: %s)", what, (int)ierr, desc);
 }
 
+/* An integer option in [lo, hi]: a one-line error naming key and value. */
+static int opt_int_in(SolverOptions *opt, const char *key, int def, int lo, int hi, int *status)
+{
+    if (*status) return def;
+    double v = solver_opt_number(opt, key, def, status);
+    if (*status) return def;
+    if (!(v >= lo && v <= hi && v == (int)v)) {
+        *status = mpm_error(MPM_EINPUT, "--solver-opt %s=%g: expected an integer in [%d, %d]", key, v, lo, hi);
+        return def;
+    }
+    return (int)v;
+}
+
 static int amg_create(SolverOptions *opt, InvApprox **out)
 {
     int st = MPM_OK;
@@ -164,7 +179,15 @@ static int amg_create(SolverOptions *opt, InvApprox **out)
     double sweeps = solver_opt_number(opt, "amg_sweeps", 1, &st);
     double rbm = solver_opt_number(opt, "amg_rbm", 0, &st);
     double max_levels = solver_opt_number(opt, "amg_max_levels", 25, &st);
+    double trunc = solver_opt_number(opt, "amg_trunc", 0.0, &st);
     const char *coarsen = solver_opt_string(opt, "amg_coarsen", "HMIS");
+    /* hypre 2.26's HYPRE_parcsr_ls.h documents each range */
+    int nodal_diag = opt_int_in(opt, "amg_nodal_diag", 0, 0, 2, &st);
+    int agg_interp = opt_int_in(opt, "amg_agg_interp", 4, 1, 7, &st);
+    int agg_pmax = opt_int_in(opt, "amg_agg_pmax", 0, 0, 1000, &st);
+    int num_paths = opt_int_in(opt, "amg_num_paths", 1, 1, 100, &st);
+    int cheby_order = opt_int_in(opt, "amg_cheby_order", 2, 1, 4, &st);
+    int rbm_qmax = opt_int_in(opt, "amg_rbm_qmax", 0, 0, 1000, &st);
     if (st) return st;
     if (!(strong > 0.0 && strong < 1.0))
         return mpm_error(MPM_EINPUT, "--solver-opt amg_strong_threshold=%g: expected a value in (0, 1)", strong);
@@ -181,15 +204,22 @@ static int amg_create(SolverOptions *opt, InvApprox **out)
                          interp);
     if (!(pmax >= 0 && pmax <= 1000 && pmax == (int)pmax))
         return mpm_error(MPM_EINPUT, "--solver-opt amg_pmax=%g: expected an integer in [0, 1000]", pmax);
-    if (!(relax == 6 || relax == 8))
+    if (!(trunc >= 0.0 && trunc < 1.0))
+        return mpm_error(MPM_EINPUT, "--solver-opt amg_trunc=%g: expected a value in [0, 1)", trunc);
+    /* smoothers that keep the V-cycle symmetric: symmetric ones on both
+     * legs (6, 8, 16 Chebyshev, 18 l1-Jacobi), or a forward sweep down with
+     * its backward twin up (3 -> 3/4, 13 -> 13/14) */
+    if (!(relax == 3 || relax == 6 || relax == 8 || relax == 13 || relax == 16 || relax == 18))
         return mpm_error(MPM_EINPUT,
-                         "--solver-opt amg_relax=%g: expected 6 or 8 (symmetric Gauss-Seidel; the V-cycle must "
-                         "stay symmetric to precondition CG)",
+                         "--solver-opt amg_relax=%g: expected 6 or 8 (symmetric Gauss-Seidel), 3 or 13 (forward down, "
+                         "backward up), 16 (Chebyshev) or 18 (l1-Jacobi): the V-cycle must stay symmetric for CG",
                          relax);
     if (!(sweeps >= 1 && sweeps <= 100 && sweeps == (int)sweeps))
         return mpm_error(MPM_EINPUT, "--solver-opt amg_sweeps=%g: expected an integer in [1, 100]", sweeps);
     if (!(rbm == 0 || rbm == 1 || rbm == 2 || rbm == 3))
         return mpm_error(MPM_EINPUT, "--solver-opt amg_rbm=%g: expected 0 (off) or an interpolation variant 1..3", rbm);
+    if (rbm && nodal == 0)
+        return mpm_error(MPM_EINPUT, "--solver-opt amg_rbm=%g: needs nodal coarsening (amg_nodal != 0)", rbm);
     if (!(max_levels >= 1 && max_levels <= 100 && max_levels == (int)max_levels))
         return mpm_error(MPM_EINPUT, "--solver-opt amg_max_levels=%g: expected an integer in [1, 100]", max_levels);
     int ctype;
@@ -210,8 +240,20 @@ static int amg_create(SolverOptions *opt, InvApprox **out)
     s->sweeps = (int)sweeps;
     s->rbm = (int)rbm;
     s->max_levels = (int)max_levels;
+    s->trunc = trunc;
+    s->nodal_diag = nodal_diag;
+    s->agg_interp = agg_interp;
+    s->agg_pmax = agg_pmax;
+    s->num_paths = num_paths;
+    s->cheby_order = cheby_order;
+    s->rbm_qmax = rbm_qmax;
     s->base.ops = &inv_boomeramg_ops;
     s->base.caps = INV_NEEDS_MATRIX | INV_SYMMETRIC | INV_POSITIVE;
+#ifndef HYPRE_USING_OPENMP
+    /* hypre's setup and V-cycle run on one thread (the matrix conversion
+     * before them is OpenMP-parallel) */
+    s->base.setup_threads = s->base.apply_threads = 1;
+#endif
     *out = &s->base;
     return MPM_OK;
 }
@@ -405,7 +447,15 @@ static int build_solver(Amg *s)
     e |= HYPRE_BoomerAMGSetAggNumLevels(s->amg, s->agg_levels);
     e |= HYPRE_BoomerAMGSetInterpType(s->amg, s->interp);
     e |= HYPRE_BoomerAMGSetPMaxElmts(s->amg, s->pmax);
+    e |= HYPRE_BoomerAMGSetNodalDiag(s->amg, s->nodal_diag);
+    e |= HYPRE_BoomerAMGSetNumPaths(s->amg, s->num_paths);
+    e |= HYPRE_BoomerAMGSetAggInterpType(s->amg, s->agg_interp);
+    e |= HYPRE_BoomerAMGSetAggPMaxElmts(s->amg, s->agg_pmax);
+    e |= HYPRE_BoomerAMGSetTruncFactor(s->amg, s->trunc);
     e |= HYPRE_BoomerAMGSetRelaxType(s->amg, s->relax);          /* down and up; coarsest -> 9 */
+    if (s->relax == 3 || s->relax == 13) /* a forward sweep down, its backward twin up: symmetric */
+        e |= HYPRE_BoomerAMGSetCycleRelaxType(s->amg, s->relax + 1, 2);
+    if (s->relax == 16) e |= HYPRE_BoomerAMGSetChebyOrder(s->amg, s->cheby_order);
     e |= HYPRE_BoomerAMGSetCycleRelaxType(s->amg, 9, 3);         /* Gaussian elimination on the coarsest level */
     e |= HYPRE_BoomerAMGSetRelaxOrder(s->amg, 0);
     e |= HYPRE_BoomerAMGSetNumSweeps(s->amg, s->sweeps);
@@ -413,6 +463,7 @@ static int build_solver(Amg *s)
     if (s->rbm) {
         e |= HYPRE_BoomerAMGSetInterpVectors(s->amg, 3, s->rot_par);
         e |= HYPRE_BoomerAMGSetInterpVecVariant(s->amg, s->rbm);
+        if (s->rbm_qmax) e |= HYPRE_BoomerAMGSetInterpVecQMax(s->amg, s->rbm_qmax);
     }
     int st = hy_check(e, "BoomerAMG options");
     if (st) return st;
@@ -450,6 +501,20 @@ static int amg_setup(InvApprox *self, const InvSetupInput *in)
         destroy_rot(s);
         return st;
     }
+    return MPM_OK;
+}
+
+/* Setup reuse (inverse_approx.h): the hierarchy and its copy of the matrix
+ * are kept as they are, a lagged preconditioner, whatever `values` asks:
+ * hypre 2.26 has no update of a whole hierarchy's values short of a new
+ * BoomerAMGSetup (only its fine-level matrix could be overwritten, which
+ * would leave the smoother and the coarse operators inconsistent). */
+static int amg_reuse(InvApprox *self, const InvSetupInput *in, int values, int *refreshed)
+{
+    Amg *s = (Amg *)self;
+    (void)values;
+    *refreshed = 0;
+    if (!in->H || in->H->n != s->n) return mpm_error(MPM_EINTERNAL, "boomeramg: reused for a different matrix");
     return MPM_OK;
 }
 
@@ -538,7 +603,8 @@ static void amg_view(const InvApprox *self, FILE *f, InvView *out)
 const InvApproxOps inv_boomeramg_ops = {"boomeramg", "one hypre BoomerAMG V-cycle (systems AMG, symmetric smoothing)",
                                         amg_create,  amg_setup,
                                         amg_apply,   amg_view,
-                                        amg_destroy, boomeramg_library_startup};
+                                        amg_destroy, boomeramg_library_startup,
+                                        amg_reuse};
 
 /* ---- library start-up and version (header: "Start-up") ---- */
 

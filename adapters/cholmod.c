@@ -16,6 +16,7 @@
 #include "adapters/cholmod.h"
 
 #include <cholmod.h>
+#include <dlfcn.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -42,6 +43,8 @@ typedef struct {
     int64_t an_nnzb;
     uint64_t an_pattern;
     int analyze_count;
+    long factorize_count;  /* numeric factorisations */
+    long symbolic_reuses;  /* of them, on a kept symbolic analysis */
     double lnz;
 } CholDirect;
 
@@ -75,6 +78,17 @@ static int chol_create(SolverOptions *opt, InvApprox **out)
     s->c.print = 0;
     s->base.ops = &inv_cholmod_ops;
     s->base.caps = INV_NEEDS_MATRIX | INV_SYMMETRIC | INV_POSITIVE;
+    /* the supernodal factorisation and solves run in the BLAS: OpenBLAS's
+     * own thread count when it is the BLAS loaded (else unknown: 0, the
+     * run's OpenMP threads, is reported) */
+    void *self = dlopen(NULL, RTLD_LAZY);
+    void *sym = self ? dlsym(self, "openblas_get_num_threads") : NULL;
+    if (sym) {
+        int (*nthreads)(void);
+        memcpy(&nthreads, &sym, sizeof nthreads); /* object pointer to function pointer, without a cast warning */
+        s->base.setup_threads = s->base.apply_threads = nthreads();
+    }
+    if (self) dlclose(self);
     *out = &s->base;
     return MPM_OK;
 }
@@ -166,6 +180,8 @@ static int convert(CholDirect *s, const Bsr *H)
     return MPM_OK;
 }
 
+static int factorize(CholDirect *s);
+
 static int chol_setup(InvApprox *self, const InvSetupInput *in)
 {
     CholDirect *s = (CholDirect *)self;
@@ -193,7 +209,36 @@ static int chol_setup(InvApprox *self, const InvSetupInput *in)
         s->an_pattern = H->pattern_id;
         s->analyze_count++;
         s->lnz = s->c.lnz;
+    } else {
+        s->symbolic_reuses++;
     }
+    return factorize(s);
+}
+
+/* Setup reuse (inverse_approx.h): values = 1 refactorises numerically on
+ * the kept symbolic analysis (the same pattern: the wrapper checked it);
+ * values = 0 keeps the factor of the earlier matrix (lagged). */
+static int chol_reuse(InvApprox *self, const InvSetupInput *in, int values, int *refreshed)
+{
+    CholDirect *s = (CholDirect *)self;
+    *refreshed = 0;
+    const Bsr *H = in->H;
+    if (!H || H->n != s->n) return mpm_error(MPM_EINTERNAL, "cholmod: reused for a different matrix");
+    if (!values || H->n == 0) return MPM_OK;
+    if (!(s->analyzed && s->an_n == H->n && s->an_nnzb == H->nnzb && s->an_pattern == H->pattern_id))
+        return chol_setup(self, in); /* cannot happen through the wrapper; stay correct anyway */
+    s->have_factor = 0;
+    int st = convert(s, H);
+    if (st) return st;
+    s->symbolic_reuses++;
+    st = factorize(s);
+    *refreshed = st == MPM_OK;
+    return st;
+}
+
+static int factorize(CholDirect *s)
+{
+    s->factorize_count++;
     int ok = cholmod_l_factorize(s->A, s->L, &s->c);
     if (!ok || s->c.status < CHOLMOD_OK || s->L->minor < s->L->n) {
         int status = s->c.status;
@@ -268,16 +313,22 @@ static void chol_view(const InvApprox *self, FILE *f, InvView *out)
 {
     const CholDirect *s = (const CholDirect *)self;
     double lnz = s->analyzed ? s->lnz : 0.0;
-    if (f) fprintf(f, "  CHOLMOD Cholesky: %d block rows, factor nonzeros %.0f, %d symbolic analyses\n", s->n, lnz,
-                   s->analyze_count);
+    if (f)
+        fprintf(f,
+                "  CHOLMOD Cholesky: %d block rows, factor nonzeros %.0f, %d symbolic analyses, %ld numeric "
+                "factorisations (%ld on a kept analysis)\n",
+                s->n, lnz, s->analyze_count, s->factorize_count, s->symbolic_reuses);
     inv_view_add(out, "factor_nnz", lnz);
     inv_view_add(out, "analyses", s->analyze_count);
+    inv_view_add(out, "factorizations", (double)s->factorize_count);
+    inv_view_add(out, "symbolic_reuses", (double)s->symbolic_reuses);
 }
 
 const InvApproxOps inv_cholmod_ops = {"cholmod", "CHOLMOD sparse Cholesky factor of the Hessian, exact solves",
                                       chol_create,  chol_setup,
                                       chol_apply,   chol_view,
-                                      chol_destroy, cholmod_library_startup};
+                                      chol_destroy, cholmod_library_startup,
+                                      chol_reuse};
 
 /* ---- library start-up and version (header: "Start-up") ---- */
 

@@ -264,6 +264,26 @@ def smoke_converged():
     return of(sum(r["status"] == "ok" and float(r["converged_fraction"]) == 1 for r in c), len(c))
 
 
+def mls_cells(transfer):
+    """mls-bench cells (not the reference runs) of one transfer that ended ok."""
+    return [r for r in table("mls-bench", "cells.csv")
+            if r.get("role", "") != "reference" and r["status"] == "ok"
+            and ("transfer=mls" in r["set"]) == (transfer == "mls")]
+
+
+def mls_pos_rms_range(transfer, solver=None):
+    """The last frame's pos_rms (dx) against the APIC reference run, over the transfer's cells."""
+    vals = []
+    for r in mls_cells(transfer):
+        if solver and r["solver"] != solver:
+            continue
+        with open(os.path.join(RESULTS, "mls-bench", "cells", r["id"], "frames.csv"), newline="") as f:
+            vals.append(float(list(csv.DictReader(f))[-1]["pos_rms"]))
+    if not vals:
+        raise Missing("results/mls-bench: no ok cell with that transfer")
+    return span(vals, 2, " to ")
+
+
 def fig18_speedup(scene, solver="gast15"):
     return sig(num(one("gast15-fig18", scene=scene, solver=solver), "speedup_total"))
 
@@ -354,6 +374,12 @@ NUMBERS = {
     "smoke.cells": lambda: cells_ok("smoke-matrix"),
     "smoke.date": lambda: run_date("smoke-matrix"),
     "smoke.converged": smoke_converged,
+    "mls.cells": lambda: cells_ok("mls-bench"),
+    "mls.date": lambda: run_date("mls-bench"),
+    "mls.pos_rms_mls": lambda: mls_pos_rms_range("mls"),
+    "mls.pos_rms_apic": lambda: mls_pos_rms_range("apic"),
+    "mls.pos_rms_mls_gast15": lambda: mls_pos_rms_range("mls", "gast15"),
+    "mls.pos_rms_apic_gast15": lambda: mls_pos_rms_range("apic", "gast15"),
     "fig18.cells": lambda: cells_ok("gast15-fig18"),
     "fig18.date": lambda: run_date("gast15-fig18"),
     "fig18.gast15_vs_semi_drop": lambda: fig18_speedup("snowball-drop"),

@@ -18,14 +18,52 @@ void inv_view_add(InvView *v, const char *key, double value)
 int inv_create(const InvApproxOps *ops, SolverOptions *opt, InvApprox **out)
 {
     *out = NULL;
+    /* the reuse options, shared by every implementation (docs/solvers.md
+     * "Setup reuse"); read here so that each is one option, not one per
+     * implementation */
+    int st = MPM_OK;
+    int every = solver_opt_int(opt, "reuse_every", 1, 0, 1000000, &st);
+    int across = solver_opt_int(opt, "reuse_across_steps", 0, 0, 1, &st);
+    int refresh = solver_opt_int(opt, "reuse_refresh", 1, 0, 1, &st);
+    if (st) return st;
+    if (!ops->reuse && (every != 1 || across))
+        return mpm_error(MPM_EINPUT,
+                         "solver option reuse_every=%d, reuse_across_steps=%d: inverse approximation '%s' cannot "
+                         "reuse its setup (expected reuse_every=1, reuse_across_steps=0)",
+                         every, across, ops->name);
     InvApprox *M = NULL;
-    int st = ops->create(opt, &M);
+    st = ops->create(opt, &M);
     if (st) return st;
     M->ops = ops;
     M->ready = 0;
     M->inner_banked = 0;
+    M->reuse_every = every;
+    M->reuse_across_steps = across;
+    M->reuse_refresh = refresh;
+    M->solve_requests = 0;
+    M->since_rebuild = 0;
+    M->have_key = 0;
+    memset(&M->reuse, 0, sizeof M->reuse);
     *out = M;
     return MPM_OK;
+}
+
+void inv_begin_solve(InvApprox *M) { M->solve_requests = 0; }
+
+/* FNV-1a over the node count, the coordinates and the matrix pattern id:
+ * equal keys mean the same active nodes in the same order with the same
+ * couplings (the grid's node order is a function of the coordinates). */
+static uint64_t reuse_key(const InvSetupInput *in)
+{
+    uint64_t h = 1469598103934665603ull;
+#define MIX(v) (h = (h ^ (uint64_t)(v)) * 1099511628211ull)
+    MIX(in->n_nodes);
+    MIX(in->H ? in->H->pattern_id : 0u);
+    MIX(in->H ? (uint64_t)in->H->nnzb : 0u);
+    if (in->coord)
+        for (size_t k = 0; k < 3 * (size_t)in->n_nodes; ++k) MIX((uint32_t)in->coord[k]);
+#undef MIX
+    return h;
 }
 
 int inv_setup(InvApprox *M, const InvSetupInput *in)
@@ -33,9 +71,36 @@ int inv_setup(InvApprox *M, const InvSetupInput *in)
     M->inner_banked += M->stats.inner_iters; /* the implementation restarts its count */
     M->stats.inner_iters = 0;
     M->stats.apply_s = 0.0;
-    M->ready = 0;
     double t0 = omp_get_wtime();
-    int st = M->ops->setup(M, in);
+    const int first = M->solve_requests++ == 0;
+    M->reuse.requests++;
+    int reuse = 0;
+    uint64_t key = 0;
+    if (M->ops->reuse) {
+        key = reuse_key(in);
+        /* what the options allow, then whether the kept setup fits */
+        int allowed = M->ready && M->have_key && (!first || M->reuse_across_steps) &&
+                      (M->reuse_every == 0 || M->since_rebuild < M->reuse_every);
+        reuse = allowed && key == M->key;
+        if (allowed && !reuse) M->reuse.pattern_misses++;
+    }
+    int st;
+    if (reuse) {
+        int refreshed = 0;
+        st = M->ops->reuse(M, in, M->reuse_refresh, &refreshed);
+        if (!st && refreshed) M->reuse.refreshes++;
+        else if (!st) M->reuse.lagged++;
+        M->since_rebuild++;
+    } else {
+        M->ready = 0;
+        M->have_key = 0;
+        st = M->ops->setup(M, in);
+        M->reuse.rebuilds++;
+        M->since_rebuild = 1;
+        M->key = key;
+        M->have_key = st == MPM_OK && M->ops->reuse;
+    }
+    if (st) M->have_key = 0; /* a failed reuse leaves nothing to reuse */
     M->stats.setup_s = omp_get_wtime() - t0;
     M->ready = st == MPM_OK;
     return st;
@@ -54,6 +119,18 @@ void inv_view(const InvApprox *M, FILE *f, InvView *out)
 {
     if (out) memset(out, 0, sizeof *out);
     if (M->ops->view) M->ops->view(M, f, out);
+    if (!M->ops->reuse) return;
+    const InvReuseStats *r = &M->reuse;
+    if (f)
+        fprintf(f, "  setup reuse (reuse_every %d, across steps %d, refresh %d): %ld requests, %ld rebuilds, %ld "
+                   "refreshes, %ld lagged, %ld pattern misses\n",
+                M->reuse_every, M->reuse_across_steps, M->reuse_refresh, r->requests, r->rebuilds, r->refreshes,
+                r->lagged, r->pattern_misses);
+    inv_view_add(out, "setup_requests", (double)r->requests);
+    inv_view_add(out, "rebuilds", (double)r->rebuilds);
+    inv_view_add(out, "refreshes", (double)r->refreshes);
+    inv_view_add(out, "lagged", (double)r->lagged);
+    inv_view_add(out, "pattern_misses", (double)r->pattern_misses);
 }
 
 void inv_destroy(InvApprox *M)

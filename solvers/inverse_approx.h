@@ -101,7 +101,28 @@ typedef struct {
      * hypre, CHOLMOD), run by the run layer before the first step so that no
      * step is charged with it (startup_s); NULL: nothing to start. */
     int (*library_startup)(void);
+    /* Optional: take `in`, whose nodes and sparsity pattern are those of the
+     * last full setup, without setting up again (setup reuse, docs/solvers.md
+     * "Setup reuse"; the wrapper decides when). values = 1: the matrix values
+     * changed; update what depends on them on the kept structure (CHOLMOD:
+     * numeric refactorisation on the kept symbolic analysis; mg: the Galerkin
+     * products on the kept transfers) and set *refreshed = 1, or keep the old
+     * numbers (a lagged inverse) and set *refreshed = 0. values = 0: keep the
+     * numbers, only take in's arrays (pointers into the step may move).
+     * Either way the result must keep the caps (symmetric, positive).
+     * NULL: the implementation is set up afresh at every request. */
+    int (*reuse)(InvApprox *self, const InvSetupInput *in, int values, int *refreshed);
 } InvApproxOps;
+
+/* Setup reuse counters (since creation): every inv_setup call is one
+ * request and exactly one of rebuilds, refreshes, lagged. */
+typedef struct {
+    long requests;
+    long rebuilds;       /* full setups */
+    long refreshes;      /* reuse op with new values applied */
+    long lagged;         /* kept as it was (values not updated) */
+    long pattern_misses; /* a reuse the options allowed, dropped because the nodes or pattern changed */
+} InvReuseStats;
 
 struct InvApprox {
     const InvApproxOps *ops;
@@ -110,15 +131,34 @@ struct InvApprox {
     /* outer PCG uses the flexible-CG beta (solvers/krylov/pcg.c); usually
      * caps & INV_VARIABLE, an option may turn it off (mg flexible=0) */
     int flexible;
+    /* threads the library behind setup and apply runs on (hypre: 1 in
+     * Debian's build); 0 = the run's OpenMP threads. Set by create. */
+    int setup_threads, apply_threads;
     /* kept by the wrappers */
     int ready;          /* the last setup succeeded */
     long inner_banked;  /* inner iterations of setups before the current one */
+    /* setup reuse: options reuse_every (K; 0 = while the key holds),
+     * reuse_across_steps, reuse_refresh, read by inv_create */
+    int reuse_every, reuse_across_steps, reuse_refresh;
+    int solve_requests;   /* requests since inv_begin_solve */
+    long since_rebuild;   /* requests since the last full setup */
+    int have_key;         /* key of the last full setup is valid */
+    uint64_t key;         /* hash of the nodes (coordinates) and the pattern id */
+    InvReuseStats reuse;
 };
 
 /* The way to use an InvApprox. inv_setup marks it ready on success (not
  * ready on failure); inv_apply refuses (MPM_EINTERNAL) when not ready. */
 int inv_create(const InvApproxOps *ops, SolverOptions *opt, InvApprox **out);
+/* inv_setup is a setup request: a full setup, or, as the reuse options
+ * allow and the implementation's reuse op supports, a refresh or a lagged
+ * reuse of the last one. A full setup happens at the first request of a
+ * solve (unless reuse_across_steps), when the node coordinates or the
+ * matrix pattern differ from the last full setup's, and once reuse_every
+ * requests have passed since it. */
 int inv_setup(InvApprox *M, const InvSetupInput *in);
+/* Marks the start of a solve (one time step): the next request is its first. */
+void inv_begin_solve(InvApprox *M);
 int inv_apply(InvApprox *M, const double *r, double *z);
 void inv_view(const InvApprox *M, FILE *f, InvView *out);
 void inv_destroy(InvApprox *M);

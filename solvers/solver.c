@@ -88,6 +88,7 @@ int solver_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *d
         .best_residual = INFINITY,
     };
     long inner0 = inv_inner_iters(s->inv);
+    inv_begin_solve(s->inv);
     int status = s->outer->ops->solve(s->outer, &c, dv, st);
     st->inner_iters = inv_inner_iters(s->inv) - inner0;
     /* the direction (Krylov solves, two-loop recursion) and the stopping

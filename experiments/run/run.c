@@ -233,6 +233,15 @@ static void write_run_json(const char *dir, const RunConfig *cfg, const Scene *s
                              limits, "particles", (json_int_t)sc->particles.n);
     if (root) json_object_set_new(root, "accuracy", (json_t *)run_accuracy_json(&ac, acc));
     if (root) json_object_set_new(root, "startup_s", json_real(library_startup_seconds()));
+    /* threads each phase ran on: the inverse approximation's library may
+     * not use the run's OpenMP team (hypre: 1 in Debian's build) */
+    const InvApprox *inv = solver->inv;
+    if (root)
+        json_object_set_new(root, "phase_threads",
+                            json_pack("{s:i, s:i, s:i, s:i, s:i, s:i, s:i}", "p2g", threads, "assemble", threads,
+                                      "inverse_setup", inv->setup_threads ? inv->setup_threads : threads,
+                                      "inverse_apply", inv->apply_threads ? inv->apply_threads : threads, "solve",
+                                      threads, "linesearch", threads, "g2p", threads));
     if (root) json_object_set_new(root, "provenance", provenance_json(threads, 0));
     char path[1200];
     snprintf(path, sizeof path, "%s/run.json", dir);

@@ -77,7 +77,7 @@ static int cj_apply(InvApprox *self, const double *r, double *z)
     return MPM_OK;
 }
 static const InvApproxOps coarse_jacobi_ops = {"mg-coarse-jacobi", "the coarsest level's block Jacobi", NULL, NULL,
-                                               cj_apply, NULL, NULL, NULL};
+                                               cj_apply, NULL, NULL, NULL, NULL};
 
 static void level_spmv(const void *ctx, const double *x, double *y) { bsr_spmv((const Bsr *)ctx, x, y); }
 
@@ -158,6 +158,57 @@ static void fill_level_info(Mg *M, int l)
     M->info.nnzb[l] = A->nnzb;
     M->info.avg_row[l] = A->n ? (double)A->nnzb / A->n : 0.0;
     M->info.max_row[l] = mx;
+}
+
+/* Galerkin products and block-diagonal inverses of levels from..nlev-1
+ * (level `from` >= 1 gets A from the finer level's A), on the kept
+ * transfers, coarse node sets and colourings. */
+static int mg_galerkin_levels(Mg *M, int from)
+{
+    for (int l = from; l < M->nlev; ++l) {
+        MgLevel *F = &M->lev[l - 1], *C = &M->lev[l];
+        double tb = omp_get_wtime();
+        int st = mg_galerkin(F->A, &F->T, &C->Aown, &M->gw);
+        if (st) return st;
+        double tc = omp_get_wtime();
+        M->info.galerkin_s += tc - tb;
+        bsr_diagonal(C->A, C->diagown);
+        char what[32];
+        snprintf(what, sizeof what, "multigrid level %d", l);
+        if ((st = block_diag_invert(C->n, C->diag, C->dinv, what))) return st;
+        M->info.diag_s += omp_get_wtime() - tc;
+    }
+    return MPM_OK;
+}
+
+/* Setup reuse (inverse_approx.h): the same fine nodes and pattern. The fine
+ * level always takes the new H and its diagonal (the smoother must see the
+ * matrix it smooths; a symmetric GS sweep on the current H keeps the V-cycle
+ * positive whatever SPD coarse operators it is combined with). values = 1
+ * recomputes the Galerkin products on the kept transfers (not for the
+ * rediscretised GMG, whose coarse levels come from particles: kept). */
+static int mg_reuse(InvApprox *self, const InvSetupInput *in, int values, int *refreshed)
+{
+    Mg *M = (Mg *)self;
+    *refreshed = 0;
+    if (M->nlev == 0 || !in->H || in->H->n != M->lev[0].n)
+        return mpm_error(MPM_EINTERNAL, "multigrid: reused for a different matrix");
+    MgLevel *L0 = &M->lev[0];
+    M->proj = in->proj;
+    L0->A = in->H;
+    L0->coord = in->coord;
+    L0->col = in->coloring;
+    L0->diag = in->diag;
+    double td = omp_get_wtime();
+    int st = block_diag_invert(L0->n, L0->diag, L0->dinv, "multigrid level 0");
+    M->info.diag_s += omp_get_wtime() - td;
+    if (st) return st;
+    if (values && !M->rediscretize && M->nlev > 1) {
+        if ((st = mg_galerkin_levels(M, 1))) return st;
+        for (int l = 0; l < M->nlev; ++l) fill_level_info(M, l);
+        *refreshed = 1;
+    }
+    return MPM_OK;
 }
 
 static int mg_setup(InvApprox *self, const InvSetupInput *in)
@@ -388,4 +439,5 @@ const InvApproxOps inv_mg_ops = {
     mg_apply,
     mg_view,
     mg_destroy,
-    NULL};
+    NULL,
+    mg_reuse};

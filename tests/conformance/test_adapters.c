@@ -423,7 +423,7 @@ static void test_boomeramg(SynthProblem *p)
             }
             inv_destroy(V);
         }
-        static const char *bad[][2] = {{"amg_coarsen", "RS"},           {"amg_nodal", "5"},     {"amg_relax", "3"},
+        static const char *bad[][2] = {{"amg_coarsen", "RS"},           {"amg_nodal", "5"},     {"amg_relax", "4"},
                                        {"amg_strong_threshold", "1.5"}, {"amg_agg_levels", "-1"}, {"amg_sweeps", "x"},
                                        {"amg_interp", "10"},            {"amg_rbm", "4"},       {"amg_max_levels", "0"}};
         for (size_t v = 0; v < sizeof bad / sizeof bad[0]; ++v) {
