@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/kernel.h"
+#include "core/radix_sort.h"
 
 #define BKEY_BITS 21
 #define BKEY_OFFSET (1 << (BKEY_BITS - 1))
@@ -124,18 +125,6 @@ oom:
     return mpm_error(MPM_EINTERNAL, "out of memory: stencils for %zu particles", n);
 }
 
-typedef struct {
-    uint64_t key;
-    size_t idx;
-} SortItem;
-
-static int cmp_sort_item(const void *a, const void *b)
-{
-    const SortItem *x = a, *y = b;
-    if (x->key != y->key) return x->key < y->key ? -1 : 1;
-    return (x->idx > y->idx) - (x->idx < y->idx);
-}
-
 static void compute_bases(const Particles *p, int *base, double inv_dx)
 {
 #pragma omp parallel for schedule(static)
@@ -146,29 +135,24 @@ static void compute_bases(const Particles *p, int *base, double inv_dx)
 /* Keeps particles sorted by base node in node_order_key order: grouped by
  * block (for the colouring) and, inside a block, by cell, so particles that
  * share all 27 stencil nodes are contiguous (the Hessian assembly sums them
- * locally before scattering). Stable, hence deterministic; cheap when
- * already sorted. */
+ * locally before scattering). Stable (ties keep their order), hence the same
+ * order at any thread count; cheap when already sorted. A parallel radix
+ * sort (core/radix_sort.c) in place of a serial qsort (issue 21). */
 static int sort_particles(Particles *p, Stencils *st, double inv_dx)
 {
     size_t n = p->n;
     compute_bases(p, st->base, inv_dx);
-    int sorted = 1;
-    uint64_t prev = 0;
-    for (size_t k = 0; k < n && sorted; ++k) {
-        uint64_t key = node_order_key(st->base + 3 * k);
-        if (k > 0 && key < prev) sorted = 0;
-        prev = key;
-    }
-    if (sorted) return MPM_OK;
-    SortItem *items = malloc(sizeof(SortItem) * n);
-    if (!items) return mpm_error(MPM_EINTERNAL, "out of memory sorting particles");
+    uint64_t *key = malloc(sizeof(uint64_t) * (n ? n : 1));
+    if (!key) return mpm_error(MPM_EINTERNAL, "out of memory sorting particles");
+    size_t unsorted = 0;
+#pragma omp parallel for schedule(static) reduction(+ : unsorted)
     for (size_t k = 0; k < n; ++k) {
-        items[k].key = node_order_key(st->base + 3 * k);
-        items[k].idx = k;
+        key[k] = node_order_key(st->base + 3 * k);
+        if (k > 0 && key[k] < node_order_key(st->base + 3 * (k - 1))) ++unsorted;
     }
-    qsort(items, n, sizeof(SortItem), cmp_sort_item);
-    for (size_t k = 0; k < n; ++k) st->perm[k] = items[k].idx;
-    free(items);
+    int status = unsorted ? radix_sort_u64(n, key, st->perm) : MPM_OK;
+    free(key);
+    if (status || !unsorted) return status;
     particles_permute(p, st->perm, st->scratch);
     compute_bases(p, st->base, inv_dx);
     return MPM_OK;

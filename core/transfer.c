@@ -48,7 +48,7 @@ void transfer_p2g(Grid *g, const Stencils *st, const Particles *p)
 }
 
 /* v_i = (mv)_i / m_i (+ dt g with an explicit force). */
-static void normalise_grid_velocity(Grid *g, const ExplicitForce *force)
+void transfer_normalise_grid_velocity(Grid *g, const ExplicitForce *force)
 {
     double gdt[3] = {0, 0, 0};
     if (force)
@@ -64,7 +64,7 @@ static void normalise_grid_velocity(Grid *g, const ExplicitForce *force)
 
 /* Linear elasticity of the supplement's benchmark: K = V_p P F^T with
  * P = mu (F + F^T - 2 I) + lambda tr(F - I) I. */
-static void explicit_stress(const ExplicitForce *force, const Particles *p, size_t k, double K[9])
+void transfer_explicit_stress(const ExplicitForce *force, const Particles *p, size_t k, double K[9])
 {
     const Material *m = &force->mats[p->mat[k]];
     const double *F = p->F + 9 * k;
@@ -95,7 +95,7 @@ void transfer_p2g_apic_force(Grid *g, const Stencils *st, const Particles *p, co
                 const double *w = st->w + MPM_STENCIL * (size_t)k, *dw = st->dw + 3 * MPM_STENCIL * (size_t)k;
                 double mp = p->mass[k], K[9] = {0};
                 if (force) {
-                    explicit_stress(force, p, (size_t)k, K);
+                    transfer_explicit_stress(force, p, (size_t)k, K);
                     for (int e = 0; e < 9; ++e) K[e] *= -force->dt;
                 }
                 for (int s = 0; s < MPM_STENCIL; ++s) {
@@ -115,7 +115,7 @@ void transfer_p2g_apic_force(Grid *g, const Stencils *st, const Particles *p, co
             }
         }
     }
-    normalise_grid_velocity(g, force);
+    transfer_normalise_grid_velocity(g, force);
 }
 
 void transfer_p2g_mls(Grid *g, const Stencils *st, const Particles *p, const ExplicitForce *force)
@@ -139,7 +139,7 @@ void transfer_p2g_mls(Grid *g, const Stencils *st, const Particles *p, const Exp
                 for (int e = 0; e < 9; ++e) Q[e] = mp * Cp[e];
                 if (force) { /* Q_p = m_p C_p - dt V_p D_p^-1 P F^T (supplement 3.1) */
                     double K[9];
-                    explicit_stress(force, p, (size_t)k, K);
+                    transfer_explicit_stress(force, p, (size_t)k, K);
                     for (int e = 0; e < 9; ++e) Q[e] -= force->dt * dinv * K[e];
                 }
                 for (int s = 0; s < MPM_STENCIL; ++s) {
@@ -157,7 +157,7 @@ void transfer_p2g_mls(Grid *g, const Stencils *st, const Particles *p, const Exp
             }
         }
     }
-    normalise_grid_velocity(g, force);
+    transfer_normalise_grid_velocity(g, force);
 }
 
 void transfer_g2p_opts(const Grid *g, const Stencils *st, Particles *p, const double *vnew, double dt,

@@ -39,6 +39,12 @@ void transfer_p2g_apic_force(Grid *g, const Stencils *st, const Particles *p, co
  * up to round-off. */
 void transfer_p2g_mls(Grid *g, const Stencils *st, const Particles *p, const ExplicitForce *force);
 
+/* The pieces the P2G kernels share (core/transfer_blocked.c uses them):
+ * K = V_p P F^T of the supplement's linear elasticity, and v_i = (mv)_i / m_i
+ * (+ dt g with an explicit force). */
+void transfer_explicit_stress(const ExplicitForce *force, const Particles *p, size_t k, double K[9]);
+void transfer_normalise_grid_velocity(Grid *g, const ExplicitForce *force);
+
 /* Which particle velocity G2P stores. */
 typedef enum {
     TRANSFER_APIC = 0,    /* APIC/RPIC: v_p = PIC velocity, C_p from B_p (apic_ratio) */

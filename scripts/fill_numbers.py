@@ -238,6 +238,22 @@ def wp_err_h_spread(eps):
     return f"{max(ratios):.0f}"
 
 
+DEC_SCENES = ("bar3", "twist", "faceless", "armacat-stiff")
+
+
+def dec_spread(study, solver, eps):
+    """The spread across the scenes of results/decrement (max/min) of the
+    median per-step err_h of one solver spec at one eps, with its range; the
+    CN cells are read from the work-precision study, which ran the same
+    scenes, scales, frames and error reference."""
+    vals = [float(r["err_h_median"]) for r in table(study, "wp.csv")
+            if r["case"] in DEC_SCENES and r["solver"] == solver and r["status"] == "ok" and r["eps"]
+            and float(r["eps"]) == eps and r["err_h_median"]]
+    if len(vals) < 2 or min(vals) <= 0:
+        raise Missing(f"results/{study}/wp.csv: fewer than two scenes for {solver} at eps {eps}")
+    return f"{max(vals) / min(vals):.0f}x ({sig(min(vals), 2)} to {sig(max(vals), 2)}, {len(vals)} scenes)"
+
+
 def check_passed(study):
     c = table(study, "check.csv")
     return of(sum(r["pass"] == "1" for r in c), len(c))
@@ -246,6 +262,26 @@ def check_passed(study):
 def smoke_converged():
     c = table("smoke-matrix", "cells.csv")
     return of(sum(r["status"] == "ok" and float(r["converged_fraction"]) == 1 for r in c), len(c))
+
+
+def mls_cells(transfer):
+    """mls-bench cells (not the reference runs) of one transfer that ended ok."""
+    return [r for r in table("mls-bench", "cells.csv")
+            if r.get("role", "") != "reference" and r["status"] == "ok"
+            and ("transfer=mls" in r["set"]) == (transfer == "mls")]
+
+
+def mls_pos_rms_range(transfer, solver=None):
+    """The last frame's pos_rms (dx) against the APIC reference run, over the transfer's cells."""
+    vals = []
+    for r in mls_cells(transfer):
+        if solver and r["solver"] != solver:
+            continue
+        with open(os.path.join(RESULTS, "mls-bench", "cells", r["id"], "frames.csv"), newline="") as f:
+            vals.append(float(list(csv.DictReader(f))[-1]["pos_rms"]))
+    if not vals:
+        raise Missing("results/mls-bench: no ok cell with that transfer")
+    return span(vals, 2, " to ")
 
 
 def fig18_speedup(scene, solver="gast15"):
@@ -326,12 +362,24 @@ NUMBERS = {
     "wp.date": lambda: run_date("work-precision"),
     "wp.err_h_range_at_1e-7": lambda: wp_err_h_range(1e-7),
     "wp.err_h_spread_at_1e-7": lambda: wp_err_h_spread(1e-7),
+    "dec.cells": lambda: cells_ok("decrement"),
+    "dec.date": lambda: run_date("decrement"),
+    "dec.pn-pcg_cn_1e-8": lambda: dec_spread("work-precision", "pn-pcg", 1e-8),
+    "dec.pn-pcg_dec_1e-4": lambda: dec_spread("decrement", "pn-pcg:stop=decrement", 1e-4),
+    "dec.hot_cn_1e-6": lambda: dec_spread("work-precision", "hot", 1e-6),
+    "dec.hot_dec_1e-4": lambda: dec_spread("decrement", "hot:stop=decrement", 1e-4),
     "stress.cells": lambda: cells_ok("stress"),
     "stress.date": lambda: run_date("stress"),
     "stress.passed": lambda: check_passed("stress"),
     "smoke.cells": lambda: cells_ok("smoke-matrix"),
     "smoke.date": lambda: run_date("smoke-matrix"),
     "smoke.converged": smoke_converged,
+    "mls.cells": lambda: cells_ok("mls-bench"),
+    "mls.date": lambda: run_date("mls-bench"),
+    "mls.pos_rms_mls": lambda: mls_pos_rms_range("mls"),
+    "mls.pos_rms_apic": lambda: mls_pos_rms_range("apic"),
+    "mls.pos_rms_mls_gast15": lambda: mls_pos_rms_range("mls", "gast15"),
+    "mls.pos_rms_apic_gast15": lambda: mls_pos_rms_range("apic", "gast15"),
     "fig18.cells": lambda: cells_ok("gast15-fig18"),
     "fig18.date": lambda: run_date("gast15-fig18"),
     "fig18.gast15_vs_semi_drop": lambda: fig18_speedup("snowball-drop"),

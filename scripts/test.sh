@@ -59,7 +59,8 @@ echo "test.sh: minimal build and its unit + conformance tests $((SECONDS - t0)) 
 # --- 3. sanitizers ---------------------------------------------------------
 # Tests too slow under ASan for CI's budget are listed here (and printed),
 # never dropped silently; they still run in step 1.
-asan_skip=${MPM_ASAN_SKIP-"test_solvers|test_mg_scene"} # 385 s and 141 s alone under ASan (release: 52 s, 32 s);
+asan_skip=${MPM_ASAN_SKIP-"test_solvers|test_solvers_mls|test_mg_scene"} # 385 s and 141 s alone under ASan (release: 52 s, 32 s;
+# test_solvers_mls: the agreement checks of test_solvers on two MLS scenes, release ~90 s CPU);
 # the multigrid code runs under ASan in test_mg and test_conformance
 t0=$SECONDS
 # the default compiler (gcc): a clang build with libFuzzer's coverage

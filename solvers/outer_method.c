@@ -82,6 +82,7 @@ int solve_should_stop(SolveCtx *c, const double *g, double E, int it, SolveStats
 {
     double res = problem_cn_residual(c->pb, g);
     st->residual = res;
+    if (it == 0) c->energy0 = E;
     double now = omp_get_wtime();
     if (c->hook) c->hook(c->hook_ctx, it, now - c->t_start, res, E);
     if (!isfinite(res) || !isfinite(E))
@@ -104,6 +105,14 @@ int solve_should_stop(SolveCtx *c, const double *g, double E, int it, SolveStats
         return solve_end(st, SOLVE_STALLED, "no decrease of the energy or the residual in %d outer iterations",
                          c->stall_iters);
     return 0;
+}
+
+int solve_direction_converged(SolveCtx *c, double gTp, double E, SolveStats *st)
+{
+    if (!(c->stop->direction_measure(gTp, c->energy0, E) < c->stop_tol)) return 0;
+    st->status = SOLVE_CONVERGED;
+    st->reason[0] = '\0';
+    return 1;
 }
 
 static void apply_assembled(const void *ctx, const double *x, double *y) { bsr_spmv((const Bsr *)ctx, x, y); }

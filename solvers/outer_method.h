@@ -12,6 +12,9 @@
  * PCApply in the wrapper, not in each implementation):
  *  - solve_should_stop() at the top of every iteration (convergence, the
  *    outer cap, the time limit, stagnation, non-finite values);
+ *  - solve_direction_converged() once the iteration's search direction is
+ *    known, before the line search (rules that decide on the direction,
+ *    stop=decrement; the method does not know which rule it has);
  *  - solve_energy() / solve_gradient() / solve_evaluate(),
  *    solve_assemble(), solve_setup_inverse(), solve_line_search(),
  *    solve_pcg() and solve_minres() for the phases timed and the work
@@ -126,6 +129,7 @@ struct SolveCtx {
     void *hook_ctx;
     /* kept by solve_should_stop */
     double t_start, best_energy, best_residual;
+    double energy0; /* E at iteration 0 (the decrement rule's E_0) */
     int last_progress;
 };
 
@@ -141,6 +145,13 @@ struct SolveCtx {
  *             for stall_iters iterations (an accepted equal energy counts as
  *             no decrease, so a stagnated solve cannot loop forever). */
 int solve_should_stop(SolveCtx *c, const double *g, double E, int it, SolveStats *st);
+/* The stopping rule's test on the iteration's search direction, after
+ * the direction and before the line search: gTp = g^T p for the method's
+ * own model minimiser p (before any fallback; NAN when p is none, e.g. a
+ * CG that met negative curvature at once), E the current energy. Returns 1
+ * with st->status converged when stop->direction_measure < stop_tol: the
+ * solve then ends at the current iterate, without the step along p. */
+int solve_direction_converged(SolveCtx *c, double gTp, double E, SolveStats *st);
 /* 1 when the solve's time limit (set->deadline) has passed. */
 int solve_past_deadline(const SolveCtx *c);
 /* Calls the iteration hook (when set) with the time since the solve began;

@@ -9,6 +9,7 @@
 #include "core/step.h"
 #include "core/transfer.h"
 #include "core/scene/scene_load.h"
+#include "core/transfer_blocked.h"
 #include "experiments/bench/machine_limits.h"
 
 typedef struct {
@@ -53,6 +54,14 @@ static void run_p2g(void *ctx)
     Simulation *s = b->sim;
     if (s->scene->transfer == TRANSFER_MLS) transfer_p2g_mls(&s->grid, &s->st, &s->p, &b->force);
     else transfer_p2g_apic_force(&s->grid, &s->st, &s->p, &b->force);
+}
+
+/* The same P2G through block-local arenas (core/transfer_blocked.c). */
+static void run_p2g_blocked(void *ctx)
+{
+    BenchCtx *b = ctx;
+    Simulation *s = b->sim;
+    transfer_p2g_blocked(&s->grid, &s->st, &s->p, &b->force, s->scene->transfer);
 }
 
 /* The supplement's G2P: velocity and affine field, F update, advection. */
@@ -228,6 +237,10 @@ int bench_run(const char *what, const RunConfig *cfg)
     if (all || !strcmp(what, "p2g")) {
         double t = machine_best_time(run_p2g, &bc, min_s, &spread);
         report(&L, model_p2g(scene.transfer == TRANSFER_MLS, npp), t, spread, "p2g");
+        KernelModel mb = model_p2g(scene.transfer == TRANSFER_MLS, npp);
+        mb.name = scene.transfer == TRANSFER_MLS ? "P2G blocked (MLS)" : "P2G blocked (APIC + force)";
+        t = machine_best_time(run_p2g_blocked, &bc, min_s, &spread);
+        report(&L, mb, t, spread, "p2g_blocked");
     }
     if (all || !strcmp(what, "g2p")) {
         double t = machine_best_time(run_g2p, &bc, min_s, &spread);

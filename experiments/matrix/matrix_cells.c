@@ -364,8 +364,10 @@ static const MatrixReference *scene_reference(const Matrix *m, const char *scene
     return m->reference.has ? &m->reference : NULL;
 }
 
-/* The reference cell of c: c's settings with the reference's solver, eps and
- * solver options, no error reference, writing its trajectory. */
+/* The reference cell of c: c's settings with the reference's solver, eps,
+ * solver options and set overrides (on top of c's: a study of transfers
+ * compares each against one of them), no error reference, writing its
+ * trajectory. */
 static int build_reference(const MatrixReference *r, const MatrixCell *c, MatrixCell *ref)
 {
     *ref = *c;
@@ -388,6 +390,18 @@ static int build_reference(const MatrixReference *r, const MatrixCell *c, Matrix
     ref->ref_id[0] = '\0';
     MatrixKvList set = {.n = 0};
     for (int i = 0; i < c->n_set; ++i) set.kv[set.n++] = c->set[i];
+    for (int i = 0; i < r->set.n; ++i) {
+        int slot = -1;
+        for (int k = 0; k < set.n; ++k)
+            if (!strcmp(set.kv[k].key, r->set.kv[i].key)) slot = k;
+        if (slot < 0) {
+            if (set.n >= MATRIX_MAX_KV)
+                return mpm_error(MPM_EINPUT, "%s: the reference run gets more than %d set entries", r->origin,
+                                 MATRIX_MAX_KV);
+            slot = set.n++;
+        }
+        set.kv[slot] = r->set.kv[i];
+    }
     int st = copy_kv(&set, &ref->set, &ref->n_set);
     if (!st) st = copy_kv(&r->solver_opts, &ref->solver_opts, &ref->n_solver_opts);
     if (!st) st = cell_identify(ref);

@@ -253,10 +253,10 @@ static int get_kv(const Matrix *m, json_t *obj, const char *path, MatrixNamedKin
     return MPM_OK;
 }
 
-/* "reference": {"solver", "eps", "solver_opts"} (false per scene: none). */
+/* "reference": {"solver", "eps", "solver_opts", "set"} (false per scene: none). */
 static int get_reference(Matrix *m, json_t *v, const char *path, int allow_false, MatrixReference *r)
 {
-    static const char *const keys[] = {"solver", "eps", "solver_opts", NULL};
+    static const char *const keys[] = {"solver", "eps", "solver_opts", "set", NULL};
     memset(r, 0, sizeof *r);
     snprintf(r->origin, sizeof r->origin, "%s", path);
     if (allow_false && json_is_false(v)) return MPM_OK;
@@ -276,6 +276,9 @@ static int get_reference(Matrix *m, json_t *v, const char *path, int allow_false
     json_t *o = json_object_get(v, "solver_opts");
     sj_path(p, sizeof p, path, "solver_opts");
     if (o && (st = get_kv(m, o, p, MATRIX_SOLVER_OPTS, &r->solver_opts))) return st;
+    json_t *sv = json_object_get(v, "set");
+    sj_path(p, sizeof p, path, "set");
+    if (sv && (st = get_kv(m, sv, p, MATRIX_SET, &r->set))) return st;
     r->has = 1;
     return MPM_OK;
 }

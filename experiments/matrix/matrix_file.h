@@ -158,6 +158,7 @@ typedef struct {
     const char *solver;       /* in the matrix's text pool */
     double eps;
     MatrixKvList solver_opts;
+    MatrixKvList set;         /* --set overrides on top of the cell's (e.g. another transfer) */
     char origin[200];         /* where it was given, for messages */
     const char *solver_origin;
 } MatrixReference;

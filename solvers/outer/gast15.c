@@ -204,6 +204,14 @@ static int gast15_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *
         }
         if (status) return status;
         s->indefinite += pr.indefinite;
+        /* the CG iterate's model decrease, before the downhill check and the
+         * clamp change p, with PN's residual correction while the curvature
+         * was positive; none without a CG iteration (negative curvature at
+         * once returns -g) (SPEC 4.1) */
+        double gTcg = pr.iters == 0 && pr.rho0 > 0.0
+                          ? NAN
+                          : vec_dot(len, s->g, s->p) - (pr.indefinite ? 0.0 : pr.rho * pr.rho);
+        if (solve_direction_converged(c, gTcg, E, st)) break;
         int dir = gast_downhill_direction(pb->n_nodes, s->mass_metric ? pb->grid->mass : NULL, s->g, s->p, s->kappa,
                                           s->rhs);
         s->newton += dir == GAST_DIR_NEWTON;

@@ -93,6 +93,8 @@ static int lbfgs_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *s
             vec_axpy(len, s->xi[i] - beta, Si, d);
         }
         double gTd = vec_dot(len, s->g, d);
+        /* the quasi-Newton model's decrease (SPEC 4.1) */
+        if (solve_direction_converged(c, gTd, E, st)) break;
         if (!(gTd < 0.0)) {
             vec_copy(len, s->g, d);
             vec_scale(len, -1.0, d);

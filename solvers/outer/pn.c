@@ -90,6 +90,13 @@ static int pn_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *st)
         }
 
         double gTp = vec_dot(len, s->g, s->p);
+        /* PCG from p = 0 keeps g^T p = -p^T H p, so -g^T p / 2 is the model
+         * decrease of the inexact Newton step, short of the exact one's by
+         * r^T H^-1 r / 2 for the PCG residual r: estimated by the
+         * preconditioned rho^2 / 2 (exact when M = H; SPEC 4.1). None
+         * without a PCG iteration (a cap of 0). */
+        double gTp_newton = pr.iters == 0 && pr.rho0 > 0.0 ? NAN : gTp - pr.rho * pr.rho;
+        if (solve_direction_converged(c, gTp_newton, E, st)) break;
         if (!(gTp < 0.0)) {
             /* not a descent direction (round-off or a capped solve): fall back
              * to steepest descent rather than stall */

@@ -74,16 +74,24 @@ void fixture_free(Fixture *f)
     particles_free(&f->p);
 }
 
-int scene_step_open(SceneStep *s, const char *scene, double scale)
+static int step_open(SceneStep *s, const char *scene, double scale, int set_transfer, TransferKind transfer)
 {
     memset(s, 0, sizeof *s);
     SceneLoadOptions lo = {.scale = scale};
     int st = scene_load(scene, &lo, &s->sc);
     if (st) return st;
     s->loaded = 1;
+    if (set_transfer) s->sc.transfer = transfer;
     if ((st = sim_init(&s->sim, &s->sc))) return st;
     s->started = 1;
     return step_begin(&s->sim);
+}
+
+int scene_step_open(SceneStep *s, const char *scene, double scale) { return step_open(s, scene, scale, 0, TRANSFER_APIC); }
+
+int scene_step_open_transfer(SceneStep *s, const char *scene, double scale, TransferKind transfer)
+{
+    return step_open(s, scene, scale, 1, transfer);
 }
 
 void scene_step_close(SceneStep *s)

@@ -40,6 +40,8 @@ typedef struct {
     int loaded, started;
 } SceneStep;
 int scene_step_open(SceneStep *s, const char *scene, double scale);
+/* The same with the scene's transfer replaced (as --set transfer=X). */
+int scene_step_open_transfer(SceneStep *s, const char *scene, double scale, TransferKind transfer);
 void scene_step_close(SceneStep *s);
 
 void fixture_default(FixtureOptions *o);

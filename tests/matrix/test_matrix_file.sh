@@ -119,4 +119,14 @@ check "--threads: the cells run with it" test "$(grep -c ' threads=3 ' "$tmp/t3.
 check "--threads: other ids" test -z "$(comm -12 <(cut -c1-12 "$tmp/dry.txt" | sort) <(cut -c1-12 "$tmp/t3.txt" | sort) | grep -E '^[0-9a-f]{12}$')"
 mk taxis '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hot"], "threads": [1, 2]}}'
 expect_input_error "--threads 3: taxis.json has a threads axis" matrix run "$tmp/taxis.json" --threads 3 --dry-run
+# reference.set overrides the cell's set: every transfer is compared against one APIC reference run
+mk refset '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hot"], "sets": {"transfer": [{"transfer": "apic"}, {"transfer": "mls"}]}},
+            "reference": {"solver": "pn-cholmod", "set": {"transfer": "apic"}}}'
+"$bin" matrix run "$tmp/refset.json" --dry-run --out "$tmp/dry" >"$tmp/refset.txt" 2>&1
+check "reference.set: 3 cells (one reference run)" grep -q "^matrix t (.*refset.json): 3 cells, 0 done, 3 to run" "$tmp/refset.txt"
+check "reference.set: the reference runs APIC" grep -q "drop/pn-cholmod eps=1e-10 .*transfer=apic (reference run)" "$tmp/refset.txt"
+ref=$(grep -m1 "(reference run)" "$tmp/refset.txt" | cut -c1-12)
+check "reference.set: the MLS cell is compared against it" grep -q "drop/hot .*transfer=mls reference=$ref" "$tmp/refset.txt"
+bad reference-set 'reference-set\.json: reference\.set: expected an object' \
+  '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hot"]}, "reference": {"solver": "pn-pcg", "set": 3}}'
 finish
