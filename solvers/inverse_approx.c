@@ -18,6 +18,7 @@ void inv_view_add(InvView *v, const char *key, double value)
 int inv_create(const InvApproxOps *ops, SolverOptions *opt, InvApprox **out)
 {
     *out = NULL;
+    if (!ops) return mpm_error(MPM_EINTERNAL, "inv_create: no inverse approximation (not in this build?)");
     /* the reuse options, shared by every implementation (docs/solvers.md
      * "Setup reuse"); read here so that each is one option, not one per
      * implementation */

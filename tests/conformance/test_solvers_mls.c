@@ -1,3 +1,4 @@
+/* needs: MPM_WITH_CHOLMOD */
 /* Solver agreement under MLS-MPM (SPEC 9; issue 21): every preset that
  * iterates to a tolerance converges on the first step of stretched-box and
  * of bar3 (E_mid 1e9) at the smoke matrix's coarse scales with
