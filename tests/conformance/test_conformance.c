@@ -502,7 +502,12 @@ static void harness(int mls)
 int main(void)
 {
     harness(0);
-    harness(1); /* MLS-MPM (SPEC 9): every part runs unchanged on the MLS Hessian */
+    /* MLS-MPM (SPEC 9): every part runs unchanged on the MLS Hessian. The
+     * sanitizer run of scripts/test.sh sets MPM_CONFORMANCE_SKIP_MLS (CI's
+     * time budget; the MLS kernels run under ASan in test_mls, test_problem
+     * and test_galerkin) and this says so. */
+    if (getenv("MPM_CONFORMANCE_SKIP_MLS")) printf("MLS pass skipped (MPM_CONFORMANCE_SKIP_MLS is set)\n");
+    else harness(1);
     misfit();
     return test_summary("test_conformance");
 }
