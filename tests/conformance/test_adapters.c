@@ -254,6 +254,21 @@ static void test_cholmod(SynthProblem *p)
     free(x);
 }
 
+/* A projected random right-hand side b (seed 21) and its exact solution x
+ * from CHOLMOD: the reference the multigrid adapters are measured against. */
+static int cholmod_reference(const SynthProblem *p, const InvSetupInput *in, double *b, double *x)
+{
+    InvApprox *C = NULL;
+    int st = inv_create(&inv_cholmod_ops, NULL, &C);
+    st |= inv_setup(C, in);
+    synth_random_vector(p->n, 21, b);
+    projection_apply(&p->proj, b);
+    st |= inv_apply(C, b, x);
+    CHECK(st == MPM_OK, "cholmod reference: %s", mpm_last_error());
+    inv_destroy(C);
+    return st;
+}
+
 static void test_boomeramg(SynthProblem *p)
 {
     const size_t len = 3 * (size_t)p->n;
@@ -261,15 +276,7 @@ static void test_boomeramg(SynthProblem *p)
     double *y = malloc(sizeof(double) * len), *My = malloc(sizeof(double) * len), *Mx = malloc(sizeof(double) * len);
     InvSetupInput in = input_of(p);
 
-    /* exact solution from CHOLMOD */
-    InvApprox *C = NULL;
-    int st = inv_create(&inv_cholmod_ops, NULL, &C);
-    st |= inv_setup(C, &in);
-    synth_random_vector(p->n, 21, b);
-    projection_apply(&p->proj, b);
-    st |= inv_apply(C, b, x);
-    CHECK(st == MPM_OK, "cholmod reference: %s", mpm_last_error());
-    inv_destroy(C);
+    int st = cholmod_reference(p, &in, b, x);
 
     InvApprox *M = NULL;
     st = inv_create(&inv_boomeramg_ops, NULL, &M);
@@ -474,14 +481,7 @@ static void test_ml(SynthProblem *p)
     double *xs = malloc(sizeof(double) * len);
     InvSetupInput in = input_of(p);
 
-    InvApprox *C = NULL;
-    int st = inv_create(&inv_cholmod_ops, NULL, &C);
-    st |= inv_setup(C, &in);
-    synth_random_vector(p->n, 21, b);
-    projection_apply(&p->proj, b);
-    st |= inv_apply(C, b, xs);
-    CHECK(st == MPM_OK, "cholmod reference: %s", mpm_last_error());
-    inv_destroy(C);
+    int st = cholmod_reference(p, &in, b, xs);
 
     InvApprox *M = NULL;
     st = inv_create(&inv_ml_ops, NULL, &M);
