@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/fcr.h"
+#include "core/hessian_cell.h"
 #include "core/mat3.h"
 #include "core/reduce.h"
 
@@ -407,31 +408,75 @@ static inline void add_complement(const StepProblem *pb, int i, double *B)
     for (int e = 0; e < 9; ++e) B[e] += ((e % 4 == 0) ? 1.0 : 0.0) - P[e];
 }
 
-/* Adds one particle's stiffness to a cell-local dense buffer
- * Kloc[s][t][3x3] (t >= s): K_st[a][c] = s_p sum_{b,d} A[(a,b),(c,d)] a_s(b) a_t(d).
- * The a-vectors are laid out per component (ax[t], ay[t], az[t]) so the
- * innermost loop over t is contiguous and vectorises. */
-static void accumulate_particle(const double *A, const double *a, double sp, double *Kloc)
+/* Adds a cell's stiffness (core/hessian_cell.h layout) into the upper
+ * triangle of H by node id: the pair (s, t), t >= s, of nodes (i, j) adds
+ * K_st to block (i, j) if i <= j, else K_st^T to block (j, i). Half the
+ * blocks of a full scatter; finish_row mirrors them once at the end. The
+ * destinations are found first and prefetched (the cell's blocks lie in 27
+ * rows of a matrix far larger than the caches: the adds wait on memory, not
+ * on arithmetic), then added. */
+static void scatter_cell(const StepProblem *pb, Bsr *H, const int node[27], const double *K)
 {
-    double ax[27], ay[27], az[27];
-    for (int t = 0; t < 27; ++t) {
-        ax[t] = a[3 * t];
-        ay[t] = a[3 * t + 1];
-        az[t] = a[3 * t + 2];
-    }
-    for (int s = 0; s < 27; ++s) {
-        if (ax[s] == 0.0 && ay[s] == 0.0 && az[s] == 0.0) continue; /* zero weight gradient */
-        double B[27];
-        contract_left(A, a + 3 * s, B);
-        for (int e = 0; e < 27; ++e) B[e] *= sp;
-        double *Ks = Kloc + 9 * 27 * s;
-        for (int ac = 0; ac < 9; ++ac) {
-            /* row (a, c) of every block K_st: B[a][3c + d] a_t(d) */
-            const double b0 = B[9 * (ac / 3) + 3 * (ac % 3)], b1 = B[9 * (ac / 3) + 3 * (ac % 3) + 1],
-                         b2 = B[9 * (ac / 3) + 3 * (ac % 3) + 2];
-            double *Kc = Ks + 27 * ac; /* layout [s][ac][t] */
-            for (int t = s; t < 27; ++t) Kc[t] += b0 * ax[t] + b1 * ay[t] + b2 * az[t];
+    int64_t dst[378];
+    short src[378]; /* HESSIAN_CELL_LD-strided offset of the pair's first entry in K; < 0: transposed */
+    int n = 0;
+    for (int si = 0; si < 27; ++si) {
+        int i = node[si];
+        if (i < 0) continue;
+        for (int ti = si; ti < 27; ++ti) {
+            int j = node[ti];
+            if (j < 0) continue;
+            int swap = i > j, row = swap ? j : i;
+            int o = swap ? g_pair_offset[ti][si] : g_pair_offset[si][ti];
+            int64_t b = 9 * (H->row_ptr[row] + pb->slot[NEIGH * (size_t)row + o]);
+            __builtin_prefetch(H->val + b, 1);
+            __builtin_prefetch(H->val + b + 8, 1);
+            dst[n] = b;
+            int off = 9 * HESSIAN_CELL_LD * si + ti;
+            src[n++] = (short)(swap ? -1 - off : off);
         }
+    }
+    for (int m = 0; m < n; ++m) {
+        double *Hb = H->val + dst[m];
+        if (src[m] >= 0) {
+            const double *k = K + src[m];
+            for (int e = 0; e < 9; ++e) Hb[e] += k[HESSIAN_CELL_LD * e];
+        } else {
+            const double *k = K + (-1 - src[m]);
+            for (int r = 0; r < 3; ++r)
+                for (int c = 0; c < 3; ++c) Hb[3 * r + c] += k[HESSIAN_CELL_LD * (3 * c + r)];
+        }
+    }
+}
+
+/* Row i after the scatter: adds the mass to the diagonal block, applies
+ * the BC projection P_i B P_j (+ I - P_i on the diagonal) to the blocks
+ * (i, j >= i) and writes their transposes into the blocks (j, i): H is
+ * symmetric, and (P_i B P_j)^T = P_j B^T P_i. Rows touch disjoint blocks. */
+static void finish_row(const StepProblem *pb, Bsr *H, int i)
+{
+    const int *ci = pb->grid->coord + 3 * (size_t)i;
+    for (int64_t k = H->row_ptr[i]; k < H->row_ptr[i + 1]; ++k) {
+        int j = H->col[k];
+        if (j < i) continue;
+        double *B = H->val + 9 * k;
+        if (j == i) {
+            double m = pb->grid->mass[i];
+            B[0] += m;
+            B[4] += m;
+            B[8] += m;
+        }
+        if (pb->bc[i] != BC_FREE || pb->bc[j] != BC_FREE) project_block(pb, i, j, B);
+        if (j == i) {
+            add_complement(pb, i, B);
+            continue;
+        }
+        /* offset of i seen from j (the slot table's index of -d) */
+        const int *cj = pb->grid->coord + 3 * (size_t)j;
+        int o = 25 * (ci[0] - cj[0] + 2) + 5 * (ci[1] - cj[1] + 2) + (ci[2] - cj[2] + 2);
+        double *Bt = H->val + 9 * (H->row_ptr[j] + pb->slot[NEIGH * (size_t)j + o]);
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) Bt[3 * c + r] = B[3 * r + c];
     }
 }
 
@@ -444,14 +489,20 @@ int problem_assemble(StepProblem *pb, Bsr *H)
     const Stencils *st = pb->st;
     const Particles *p = pb->parts;
     double dt2 = pb->dt * pb->dt;
-    memset(H->val, 0, sizeof(double) * 9 * (size_t)H->nnzb);
+    /* zero the blocks (i, j >= i), the row's tail (sorted columns); finish_row writes the others */
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < pb->n_nodes; ++i) {
+        int64_t kd = H->row_ptr[i];
+        while (kd < H->row_ptr[i + 1] && H->col[kd] < i) ++kd;
+        memset(H->val + 9 * kd, 0, sizeof(double) * 9 * (size_t)(H->row_ptr[i + 1] - kd));
+    }
     const NodeColoring *pc = &st->pcolor;
     for (int c = 0; c < MPM_NUM_COLORS; ++c) {
 #pragma omp parallel
         {
             /* particles sharing a base node share all 27 stencil nodes: sum
              * them in a dense cell buffer, scatter once per cell */
-            static _Thread_local double Kloc[27 * 27 * 9]; /* no allocation per call */
+            static _Thread_local _Alignas(32) double Kloc[HESSIAN_CELL_SIZE]; /* no allocation per call */
 #pragma omp for schedule(dynamic, 2)
             for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
                 int q = pc->color_blocks[qi];
@@ -460,9 +511,8 @@ int problem_assemble(StepProblem *pb, Bsr *H)
                     const int *b0 = st->base + 3 * (size_t)k;
                     int k1 = k + 1;
                     while (k1 < kend && memcmp(st->base + 3 * (size_t)k1, b0, 3 * sizeof(int)) == 0) ++k1;
-                    memset(Kloc, 0, sizeof(double) * 27 * 27 * 9);
-                    for (int kk = k; kk < k1; ++kk)
-                        accumulate_particle(pb->A + 81 * (size_t)kk, pb->a + 81 * (size_t)kk, dt2 * p->vol[kk], Kloc);
+                    hessian_cell(k1 - k, pb->A + 81 * (size_t)k, pb->a + 81 * (size_t)k, p->vol + k, dt2, Kloc,
+                                 pb->cell_kernel);
                     /* node ids of the cell: union over its particles (a node
                      * is -1 only where every weight vanishes) */
                     int node[27];
@@ -470,46 +520,14 @@ int problem_assemble(StepProblem *pb, Bsr *H)
                     for (int kk = k + 1; kk < k1; ++kk)
                         for (int t = 0; t < 27; ++t)
                             if (node[t] < 0) node[t] = st->node[27 * (size_t)kk + t];
-                    for (int si = 0; si < 27; ++si) {
-                        int i = node[si];
-                        if (i < 0) continue;
-                        const short *slot_i = pb->slot + NEIGH * (size_t)i;
-                        int64_t r0 = H->row_ptr[i];
-                        const double *Ks = Kloc + 9 * 27 * si;
-                        for (int ti = si; ti < 27; ++ti) {
-                            int j = node[ti];
-                            if (j < 0) continue;
-                            double *Hij = H->val + 9 * (r0 + slot_i[g_pair_offset[si][ti]]);
-                            for (int e = 0; e < 9; ++e) Hij[e] += Ks[27 * e + ti];
-                            if (ti != si) {
-                                double *Hji =
-                                    H->val + 9 * (H->row_ptr[j] + pb->slot[NEIGH * (size_t)j + g_pair_offset[ti][si]]);
-                                for (int r = 0; r < 3; ++r)
-                                    for (int cc = 0; cc < 3; ++cc) Hji[3 * r + cc] += Ks[27 * (3 * cc + r) + ti];
-                            }
-                        }
-                    }
+                    scatter_cell(pb, H, node, Kloc);
                     k = k1;
                 }
             }
         }
     }
-    /* mass and boundary conditions */
-    const double *m = pb->grid->mass;
-#pragma omp parallel for schedule(static)
-    for (int i = 0; i < pb->n_nodes; ++i) {
-        for (int64_t k = H->row_ptr[i]; k < H->row_ptr[i + 1]; ++k) {
-            double *Bk = H->val + 9 * k;
-            int j = H->col[k];
-            if (j == i) {
-                Bk[0] += m[i];
-                Bk[4] += m[i];
-                Bk[8] += m[i];
-            }
-            if (pb->bc[i] != BC_FREE || pb->bc[j] != BC_FREE) project_block(pb, i, j, Bk);
-            if (j == i) add_complement(pb, i, Bk);
-        }
-    }
+#pragma omp parallel for schedule(dynamic, 64)
+    for (int i = 0; i < pb->n_nodes; ++i) finish_row(pb, H, i);
     return MPM_OK;
 }
 

@@ -65,6 +65,7 @@ typedef struct StepProblem {
     double *F, *P;       /* 9 per particle at the last problem_energy point */
     double *A;           /* 81 per particle after problem_tangent */
     int tangent_projected;
+    int cell_kernel;     /* HESSIAN_CELL_AUTO (0) or _PORTABLE: the assembly's cell kernel (core/hessian_cell.h) */
     double elastic_energy;
 
     /* Hessian sparsity (per step) */

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/hessian_cell.h"
 #include "core/step.h"
 #include "core/transfer.h"
 #include "core/scene/scene_load.h"
@@ -230,6 +231,7 @@ int bench_run(const char *what, const RunConfig *cfg)
     if (all || !strcmp(what, "assemble")) {
         double t = machine_best_time(run_assemble, &bc, min_s, &spread);
         report(&L, model_assemble((double)H.nnzb / (double)np), t, spread, "assemble");
+        printf("assemble_kernel_isa=%s\n", hessian_cell_isa());
         double t2 = machine_best_time(run_scatter, &bc, min_s, NULL);
         printf("%-28s %10.3f ms %10.3g p/s\nscatter_particles_per_s=%.4g\n", "assemble (scatter only)", 1e3 * t2,
                np / t2, np / t2);

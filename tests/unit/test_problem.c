@@ -149,7 +149,7 @@ static void test_assembled_equals_matrix_free(int with_bc, int mls)
         err += (y1[i] - y2[i]) * (y1[i] - y2[i]);
         nrm += y1[i] * y1[i];
     }
-    CHECK(sqrt(err / nrm) < 1e-12, "assembled vs matrix-free (bc=%d, mls=%d): rel diff %.3e", with_bc, mls,
+    CHECK(sqrt(err / nrm) < 1e-14, "assembled vs matrix-free (bc=%d, mls=%d): rel diff %.3e", with_bc, mls,
           sqrt(err / nrm));
     /* diagonal blocks agree too */
     double *D1 = calloc(9 * (size_t)n, sizeof(double)), *D2 = calloc(9 * (size_t)n, sizeof(double));
