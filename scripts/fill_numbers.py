@@ -284,6 +284,19 @@ def mls_pos_rms_range(transfer, solver=None):
     return span(vals, 2, " to ")
 
 
+def mls_time_ratio(solver):
+    """MLS/APIC s/frame over the scenes, for one solver (cells that ran on a quiet machine)."""
+    by = {}
+    for t in ("apic", "mls"):
+        for r in mls_cells(t):
+            if r["solver"] == solver and r.get("machine_busy", "0") != "1":
+                by[(r["scene"], t)] = float(r["s_per_frame"])
+    ratios = [by[(sc, "mls")] / by[(sc, "apic")] for (sc, t) in by if t == "apic" and (sc, "mls") in by]
+    if not ratios:
+        raise Missing("results/mls-bench: no scene with both transfers timed on a quiet machine")
+    return span(ratios, 3)
+
+
 def fig18_speedup(scene, solver="gast15"):
     return sig(num(one("gast15-fig18", scene=scene, solver=solver), "speedup_total"))
 
@@ -380,6 +393,8 @@ NUMBERS = {
     "mls.pos_rms_apic": lambda: mls_pos_rms_range("apic"),
     "mls.pos_rms_mls_gast15": lambda: mls_pos_rms_range("mls", "gast15"),
     "mls.pos_rms_apic_gast15": lambda: mls_pos_rms_range("apic", "gast15"),
+    "mls.time_ratio_hot": lambda: mls_time_ratio("hot"),
+    "mls.time_ratio_pn-pcg": lambda: mls_time_ratio("pn-pcg"),
     "fig18.cells": lambda: cells_ok("gast15-fig18"),
     "fig18.date": lambda: run_date("gast15-fig18"),
     "fig18.gast15_vs_semi_drop": lambda: fig18_speedup("snowball-drop"),

@@ -22,6 +22,9 @@
 #include <string.h>
 
 #include "adapters/boomeramg.h"
+#ifdef MPM_WITH_ML
+#include "adapters/ml.h"
+#endif
 #include "adapters/cholmod.h"
 #include "core/error.h"
 #include "core/vec.h"
@@ -173,11 +176,17 @@ int main(void)
     CHECK(B.n != A1.n, "B must have other nodes");
     printf("nodes: %d (A1, A2), %d (B)\n", A1.n, B.n);
 
-    const InvApproxOps *reusable[3] = {&inv_mg_ops, &inv_cholmod_ops, &inv_boomeramg_ops};
+    /* mg and CHOLMOD can refresh; BoomerAMG and ML only lag (k >= 2) */
+#ifdef MPM_WITH_ML
+    const InvApproxOps *reusable[] = {&inv_mg_ops, &inv_cholmod_ops, &inv_boomeramg_ops, &inv_ml_ops};
+#else
+    const InvApproxOps *reusable[] = {&inv_mg_ops, &inv_cholmod_ops, &inv_boomeramg_ops};
+#endif
+    const int n_reusable = (int)(sizeof reusable / sizeof reusable[0]);
     const char *mg_fixed = "coarse_exact=1,min_coarse_nodes=50"; /* a fixed symmetric V-cycle */
 
     /* 1. reuse_every=1: every request a full setup, bitwise a fresh object's */
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < n_reusable; ++k) {
         const char *extra = k == 0 ? mg_fixed : "";
         char opts[128];
         snprintf(opts, sizeof opts, "%s%sreuse_every=1", extra, extra[0] ? "," : "");
@@ -213,7 +222,7 @@ int main(void)
 
     /* 3. lagged: still symmetric and positive; PCG on A2 reaches the same
      * tolerance as with a fresh setup (a few more iterations) */
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < n_reusable; ++k) {
         const char *extra = k == 0 ? mg_fixed : "";
         char opts[128];
         snprintf(opts, sizeof opts, "%s%sreuse_every=0,reuse_refresh=0", extra, extra[0] ? "," : "");
@@ -237,9 +246,34 @@ int main(void)
         inv_destroy(F);
     }
 
+    /* 3b. lagged means the old inverse even when the caller overwrites its
+     * matrix in place (as a step does between Newton iterations): CHOLMOD,
+     * BoomerAMG and ML keep what they were built on (ML through its own
+     * copy of the matrix, which its V-cycle reads at every application) */
+    for (int k = 1; k < n_reusable; ++k) {
+        SynthProblem W;
+        int wst = synth_build(&W, &sp); /* the values of A1, in storage the test overwrites */
+        CHECK(wst == MPM_OK && W.A.nnzb == A2.A.nnzb, "synth_build W: %s", mpm_last_error());
+        if (wst) break;
+        InvApprox *M = create(reusable[k], "reuse_every=0,reuse_refresh=0"), *F = create(reusable[k], "");
+        inv_begin_solve(M);
+        setup(M, &W);
+        memcpy(W.A.val, A2.A.val, sizeof(double) * 9 * (size_t)A2.A.nnzb);
+        memcpy(W.diag, A2.diag, sizeof(double) * 9 * (size_t)A2.n);
+        setup(M, &W); /* lagged */
+        check_counters(M, 2, 1, 0, 1, 0, reusable[k]->name);
+        setup(F, &A1);
+        double d = apply_diff(M, F, A1.n, 5);
+        CHECK(d < 1e-12, "%s lagged after an in-place overwrite: differs from the inverse of the old matrix by %.3g",
+              reusable[k]->name, d);
+        inv_destroy(M);
+        inv_destroy(F);
+        synth_free(&W);
+    }
+
     /* 4. across steps: kept while the nodes and pattern hold, dropped when
      * they change; without the option every step rebuilds */
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < n_reusable; ++k) {
         const char *extra = k == 0 ? mg_fixed : "";
         char opts[128];
         snprintf(opts, sizeof opts, "%s%sreuse_every=0,reuse_across_steps=1", extra, extra[0] ? "," : "");
@@ -248,7 +282,7 @@ int main(void)
         setup(M, &A1);
         inv_begin_solve(M); /* step 2: same nodes and pattern */
         setup(M, &A2);
-        long refreshed = k == 2 ? 0 : 1;
+        long refreshed = k >= 2 ? 0 : 1;
         check_counters(M, 2, 1, refreshed, 1 - refreshed, 0, reusable[k]->name);
         inv_begin_solve(M); /* step 3: the active set changed */
         setup(M, &B);
