@@ -297,6 +297,31 @@ def mls_time_ratio(solver):
     return span(ratios, 3)
 
 
+ALGEBRAIC = ("pn-amg-pcg", "lbfgs-amg", "pn-ml-pcg", "lbfgs-ml")
+
+
+def baselines_lead(threads, what="geo"):
+    """The fastest algebraic multigrid's s/frame over HOT's, per scene at one
+    thread count (cells converged on a quiet machine): geometric mean and range."""
+    by = {}
+    for r in table("baselines", "cells.csv"):
+        if (r["threads"] == str(threads) and r["status"] == "ok" and r["worst_solve_status"] == "converged"
+                and r.get("machine_busy", "0") != "1"):
+            by.setdefault(r["scene"], {})[r["solver"]] = float(r["s_per_frame"])
+    ratios = []
+    for sc, t in by.items():
+        alg = [t[s] for s in ALGEBRAIC if s in t]
+        if "hot" in t and alg:
+            ratios.append(min(alg) / t["hot"])
+    if not ratios:
+        raise Missing(f"results/baselines: no scene with hot and an algebraic multigrid at {threads} threads")
+    if what == "range":
+        return span(ratios, 3)
+    if what == "n":
+        return str(len(ratios))
+    return sig(math.exp(sum(math.log(x) for x in ratios) / len(ratios)), 3)
+
+
 def fig18_speedup(scene, solver="gast15"):
     return sig(num(one("gast15-fig18", scene=scene, solver=solver), "speedup_total"))
 
@@ -394,6 +419,13 @@ NUMBERS = {
     "mls.pos_rms_mls_gast15": lambda: mls_pos_rms_range("mls", "gast15"),
     "mls.pos_rms_apic_gast15": lambda: mls_pos_rms_range("apic", "gast15"),
     "mls.time_ratio_hot": lambda: mls_time_ratio("hot"),
+    "base.cells": lambda: cells_ok("baselines"),
+    "base.date": lambda: run_date("baselines"),
+    "base.lead_2t": lambda: baselines_lead(2),
+    "base.lead_2t_range": lambda: baselines_lead(2, "range"),
+    "base.lead_2t_n": lambda: baselines_lead(2, "n"),
+    "base.lead_1t": lambda: baselines_lead(1),
+    "base.lead_1t_range": lambda: baselines_lead(1, "range"),
     "mls.time_ratio_pn-pcg": lambda: mls_time_ratio("pn-pcg"),
     "fig18.cells": lambda: cells_ok("gast15-fig18"),
     "fig18.date": lambda: run_date("gast15-fig18"),

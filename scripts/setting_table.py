@@ -8,7 +8,8 @@ row per cell, grouped by scene, solver and threads: seconds per timed
 frame, its ratio to the group's first setting (the default), outer and
 linear iterations, the share of the timed steps spent in the inverse
 approximation's setup (steps.csv setup_s over wall_s), the setup counters
-(inverse_stats.csv) and the status. Then, per setting, the geometric mean
+and the last hierarchy's operator complexity (inverse_stats.csv) and the
+status. Then, per setting, the geometric mean
 of the ratio over the groups where every setting ended converged, so a
 setting is judged on all scenes at once. Cells that ran while the machine
 was busy are marked and left out of the means.
@@ -36,9 +37,11 @@ def setup_share(d, r):
 
 def counters(d, r):
     st = {row["key"]: row["value"] for row in read_csv(os.path.join(d, "cells", r["id"], "inverse_stats.csv"))}
+    oc = st.get("operator_complexity")
+    oc = f"{float(oc):.2f}" if oc else "-"
     if "rebuilds" not in st:
-        return "-"
-    return f"{st['rebuilds']} / {st.get('refreshes', '0')} / {st.get('lagged', '0')}"
+        return "-", oc
+    return f"{st['rebuilds']} / {st.get('refreshes', '0')} / {st.get('lagged', '0')}", oc
 
 
 def ok(r):
@@ -56,8 +59,8 @@ def main(d, axis):
     for r in cells:
         groups.setdefault((r["scene"], r["solver"], r["threads"]), []).append(r)
     print(f"| scene | solver | threads | {axis} | s/frame | / first | outer | linear | setup share |"
-          " rebuilds / refreshes / lagged | status |")
-    print("|---|---|---:|---|---:|---:|---:|---:|---:|---|---|")
+          " rebuilds / refreshes / lagged | op. complexity | status |")
+    print("|---|---|---:|---|---:|---:|---:|---:|---:|---|---:|---|")
     ratios = {s: [] for s in settings}
     for (scene, solver, threads), rows in groups.items():
         rows.sort(key=lambda r: settings.index(r[axis]))
@@ -74,7 +77,7 @@ def main(d, axis):
                 status += " (machine busy: time not valid)"
             print(f"| {scene} | {solver} | {threads} | {r[axis]} | {t:.3g} | "
                   f"{'-' if ratio != ratio else f'{ratio:.2f}'} | {r['outer_iters']} | {r['linear_iters']} | "
-                  f"{setup_share(d, r):.0%} | {counters(d, r)} | {status} |")
+                  f"{setup_share(d, r):.0%} | {' | '.join(counters(d, r))} | {status} |")
     print()
     print(f"Geometric mean of s/frame relative to the first {axis} over the groups where every setting"
           " converged on a quiet machine (below 1: faster):")

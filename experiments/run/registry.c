@@ -63,12 +63,16 @@ static const SolverPreset g_presets[] = {
      "matrix_free=1"},
     {"pn-sgs-pcg", "projected Newton, PCG preconditioned by one coloured symmetric block Gauss-Seidel sweep (HOT Table 3)",
      "pn", "sgs", ""},
-    {"pn-mgpcg", "projected Newton, PCG preconditioned by one node-embedding Galerkin V-cycle, rebuilt every iteration (HOT PN-MGPCG)",
-     "pn", "mg", ""},
-    {"pn-amg-pcg", "projected Newton, PCG preconditioned by one hypre BoomerAMG V-cycle (algebraic baseline)", "pn",
-     "boomeramg", ""},
-    {"pn-ml-pcg", "projected Newton, PCG preconditioned by one Trilinos ML smoothed-aggregation V-cycle (algebraic "
-     "baseline)", "pn", "ml", ""},
+    /* the setup-bearing presets keep their setup for the step where that
+     * was faster at the same CN tolerance (results/reuse, results/amg-tuning,
+     * results/ml-tuning; docs/solvers.md "Setup reuse") */
+    {"pn-mgpcg", "projected Newton, PCG preconditioned by one node-embedding Galerkin V-cycle, its coarse levels "
+     "kept for the step (HOT PN-MGPCG with setup reuse; reuse_every=1 rebuilds every iteration as HOT does)",
+     "pn", "mg", "reuse_every=0,reuse_refresh=0"},
+    {"pn-amg-pcg", "projected Newton, PCG preconditioned by one hypre BoomerAMG V-cycle, tuned, kept for the step "
+     "(algebraic baseline)", "pn", "boomeramg", "amg_strong_threshold=0.25,reuse_every=0"},
+    {"pn-ml-pcg", "projected Newton, PCG preconditioned by one Trilinos ML aggregation V-cycle, tuned, kept for the "
+     "step (algebraic baseline)", "pn", "ml", "ml_damping=0,reuse_every=0"},
     {"pn-cholmod", "projected Newton with exact CHOLMOD Cholesky solves (exact-Newton reference)", "pn", "cholmod", ""},
     {"hot", "L-BFGS, initial inverse = one linear-embedding Galerkin multigrid V-cycle built once per step (HOT)",
      "lbfgs", "mg", ""},
@@ -81,8 +85,10 @@ static const SolverPreset g_presets[] = {
      "lbfgs", "inexact-pcg", ""},
     {"lbfgs-h-direct", "L-BFGS, initial inverse = CHOLMOD factor of the start-of-step Hessian (Li et al. 2019)", "lbfgs",
      "cholmod", ""},
-    {"lbfgs-amg", "L-BFGS, initial inverse = one hypre BoomerAMG V-cycle", "lbfgs", "boomeramg", ""},
-    {"lbfgs-ml", "L-BFGS, initial inverse = one Trilinos ML smoothed-aggregation V-cycle", "lbfgs", "ml", ""},
+    {"lbfgs-amg", "L-BFGS, initial inverse = one hypre BoomerAMG V-cycle (pn-amg-pcg's tuned options)", "lbfgs",
+     "boomeramg", "amg_strong_threshold=0.25"},
+    {"lbfgs-ml", "L-BFGS, initial inverse = one Trilinos ML aggregation V-cycle (pn-ml-pcg's tuned options)", "lbfgs",
+     "ml", "ml_damping=0"},
     {"gast15", "Gast et al. 2015: unprojected Newton, CG stopping at indefiniteness, strong Wolfe, ||g|| < 1e-3, "
      "rest-configuration diagonal preconditioner, matrix-free", "gast15", "gast-diagonal", "linesearch=wolfe,stop=l2"},
     {"gast15-hot", "what the HOT study ran as Gast15: matrix-free projected Newton, block Jacobi, halving, ||g|| < 1e-3, "

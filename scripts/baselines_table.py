@@ -1,0 +1,117 @@
+#!/usr/bin/env python3
+"""HOT against the tuned algebraic baselines at equal cores (issue 20).
+
+    python3 scripts/baselines_table.py results/baselines > results/baselines/tables.md
+
+From a finished experiments/matrices/baselines.json run: seconds per timed
+frame of every solver per scene and thread count, then HOT's lead over the
+fastest algebraic multigrid (BoomerAMG or ML, with PN or L-BFGS) and over
+the fastest of everything else, then per cell the outer and linear
+iterations, the share of the timed steps spent in the setup and the last
+hierarchy's operator complexity. Cells that did not converge or ran on a
+busy machine are marked and not compared.
+"""
+import csv
+import math
+import os
+import sys
+
+ALGEBRAIC = ("pn-amg-pcg", "lbfgs-amg", "pn-ml-pcg", "lbfgs-ml")
+
+
+def read_csv(path):
+    if not os.path.exists(path):
+        return []
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def good(r):
+    return r["status"] == "ok" and r["worst_solve_status"] == "converged" and r.get("machine_busy", "0") != "1"
+
+
+def setup_share(d, r):
+    first = int(r.get("first_timed_frame") or 0)
+    steps = [s for s in read_csv(os.path.join(d, "cells", r["id"], "steps.csv")) if int(s["frame"]) >= first]
+    wall = sum(float(s["wall_s"]) for s in steps)
+    setup = sum(float(s["setup_s"] or 0) for s in steps)
+    return setup / wall if wall > 0 else float("nan")
+
+
+def op_complexity(d, r):
+    for row in read_csv(os.path.join(d, "cells", r["id"], "inverse_stats.csv")):
+        if row["key"] == "operator_complexity":
+            return f"{float(row['value']):.2f}"
+    return "-"
+
+
+def main(d):
+    cells = [r for r in read_csv(os.path.join(d, "cells.csv")) if r.get("role", "") != "reference"]
+    if not cells:
+        sys.exit(f"{d}/cells.csv: no cells")
+    scenes = list(dict.fromkeys(r["scene"] for r in cells))
+    solvers = list(dict.fromkeys(r["solver"] for r in cells))
+    threads = sorted({r["threads"] for r in cells}, key=int, reverse=True)
+    by = {(r["scene"], r["threads"], r["solver"]): r for r in cells}
+
+    print("## Seconds per timed frame\n")
+    print("| scene | threads | " + " | ".join(solvers) + " |")
+    print("|---|---:|" + "---:|" * len(solvers))
+    leads = {t: [] for t in threads}
+    for sc in scenes:
+        for t in threads:
+            row = []
+            for so in solvers:
+                r = by.get((sc, t, so))
+                if not r:
+                    row.append("")
+                    continue
+                v = f"{float(r['s_per_frame']):.3g}" if r["s_per_frame"] else "-"
+                row.append(v if good(r) else f"{v} ({r['worst_solve_status'] or r['status']})")
+            print(f"| {sc} | {t} | " + " | ".join(row) + " |")
+
+    print("\n## HOT's lead (s/frame of the other over HOT's)\n")
+    print("| scene | threads | fastest algebraic | its s/frame over HOT's | fastest other (not HOT) | its s/frame over HOT's |")
+    print("|---|---:|---|---:|---|---:|")
+    for sc in scenes:
+        for t in threads:
+            hot = by.get((sc, t, "hot"))
+            if not hot or not good(hot):
+                continue
+            h = float(hot["s_per_frame"])
+            alg = [by[(sc, t, s)] for s in ALGEBRAIC if (sc, t, s) in by and good(by[(sc, t, s)])]
+            oth = [by[(sc, t, s)] for s in solvers if s != "hot" and (sc, t, s) in by and good(by[(sc, t, s)])]
+            a = min(alg, key=lambda r: float(r["s_per_frame"])) if alg else None
+            o = min(oth, key=lambda r: float(r["s_per_frame"])) if oth else None
+            if a:
+                leads[t].append(float(a["s_per_frame"]) / h)
+            print(f"| {sc} | {t} | {a['solver'] if a else '-'} | "
+                  f"{float(a['s_per_frame']) / h:.2f} | " if a else f"| {sc} | {t} | - | - | ", end="")
+            print(f"{o['solver']} | {float(o['s_per_frame']) / h:.2f} |" if o else "- | - |")
+    for t in threads:
+        v = leads[t]
+        if v:
+            g = math.exp(sum(math.log(x) for x in v) / len(v))
+            print(f"\nAt {t} thread{'s' if t != '1' else ''}: the fastest algebraic multigrid takes {g:.2f}x HOT's time "
+                  f"(geometric mean over {len(v)} scenes, {min(v):.2f}-{max(v):.2f}).")
+
+    print("\n## Iterations, setup share, operator complexity\n")
+    print("| scene | threads | solver | s/frame | outer | linear | setup share | op. complexity | status |")
+    print("|---|---:|---|---:|---:|---:|---:|---:|---|")
+    for sc in scenes:
+        for t in threads:
+            for so in solvers:
+                r = by.get((sc, t, so))
+                if not r:
+                    continue
+                st = r["worst_solve_status"] or r["status"]
+                if r.get("machine_busy", "0") == "1":
+                    st += " (machine busy)"
+                print(f"| {sc} | {t} | {so} | {float(r['s_per_frame'] or 'nan'):.3g} | {r['outer_iters']} | {r['linear_iters']} | "
+                      f"{setup_share(d, r):.0%} | {op_complexity(d, r)} | {st} |")
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 2:
+        sys.exit(__doc__)
+    main(sys.argv[1])
