@@ -2,6 +2,7 @@
 """HOT against the tuned algebraic baselines at equal cores (issue 20).
 
     python3 scripts/baselines_table.py results/baselines > results/baselines/tables.md
+    python3 scripts/baselines_table.py results/baselines-repeat > results/baselines-repeat/spread.md
 
 From a finished experiments/matrices/baselines.json run: seconds per timed
 frame of every solver per scene and thread count, then HOT's lead over the
@@ -9,7 +10,8 @@ fastest algebraic multigrid (BoomerAMG or ML, with PN or L-BFGS) and over
 the fastest of everything else, then per cell the outer and linear
 iterations, the share of the timed steps spent in the setup and the last
 hierarchy's operator complexity. Cells that did not converge or ran on a
-busy machine are marked and not compared.
+busy machine are marked and not compared. A run with repeats gets the
+spread table instead (spread()).
 """
 import csv
 import math
@@ -45,10 +47,38 @@ def op_complexity(d, r):
     return "-"
 
 
+def spread(d):
+    """For a run with repeats (matrix key "repeat"): per scene and thread
+    count, each solver's median s/frame and the spread of its runs
+    ((max - min) / median), and the ratio of the two solvers' medians with
+    its range over all pairs of runs."""
+    cells = [r for r in read_csv(os.path.join(d, "cells.csv")) if good(r)]
+    runs = {}
+    for r in cells:
+        runs.setdefault((r["scene"], r["threads"]), {}).setdefault(r["solver"], []).append(float(r["s_per_frame"]))
+    solvers = list(dict.fromkeys(r["solver"] for r in cells))
+    a, b = solvers[0], solvers[-1]
+    print(f"| scene | threads | runs | {a}: median s/frame (spread) | {b}: median s/frame (spread) |"
+          f" {b} / {a}: median (range over run pairs) |")
+    print("|---|---:|---:|---:|---:|---:|")
+    for (sc, t), by in runs.items():
+        if a not in by or b not in by:
+            continue
+        med = {k: sorted(v)[len(v) // 2] if len(v) % 2 else sum(sorted(v)[len(v) // 2 - 1:len(v) // 2 + 1]) / 2
+               for k, v in by.items()}
+        pairs = [y / x for x in by[a] for y in by[b]]
+        print(f"| {sc} | {t} | {len(by[a])} | {med[a]:.3g} ({(max(by[a]) - min(by[a])) / med[a]:.0%}) | "
+              f"{med[b]:.3g} ({(max(by[b]) - min(by[b])) / med[b]:.0%}) | {med[b] / med[a]:.2f} "
+              f"({min(pairs):.2f}-{max(pairs):.2f}) |")
+
+
 def main(d):
     cells = [r for r in read_csv(os.path.join(d, "cells.csv")) if r.get("role", "") != "reference"]
     if not cells:
         sys.exit(f"{d}/cells.csv: no cells")
+    if any(r.get("repeat", "") not in ("", "1") for r in cells):
+        spread(d)
+        return
     scenes = list(dict.fromkeys(r["scene"] for r in cells))
     solvers = list(dict.fromkeys(r["solver"] for r in cells))
     threads = sorted({r["threads"] for r in cells}, key=int, reverse=True)
