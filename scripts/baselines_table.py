@@ -13,38 +13,21 @@ hierarchy's operator complexity. Cells that did not converge or ran on a
 busy machine are marked and not compared. A run with repeats gets the
 spread table instead (spread()).
 """
-import csv
 import math
 import os
 import sys
 
+from setting_table import counters, read_csv, setup_share
+
 ALGEBRAIC = ("pn-amg-pcg", "lbfgs-amg", "pn-ml-pcg", "lbfgs-ml")
-
-
-def read_csv(path):
-    if not os.path.exists(path):
-        return []
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
 
 
 def good(r):
     return r["status"] == "ok" and r["worst_solve_status"] == "converged" and r.get("machine_busy", "0") != "1"
 
 
-def setup_share(d, r):
-    first = int(r.get("first_timed_frame") or 0)
-    steps = [s for s in read_csv(os.path.join(d, "cells", r["id"], "steps.csv")) if int(s["frame"]) >= first]
-    wall = sum(float(s["wall_s"]) for s in steps)
-    setup = sum(float(s["setup_s"] or 0) for s in steps)
-    return setup / wall if wall > 0 else float("nan")
-
-
 def op_complexity(d, r):
-    for row in read_csv(os.path.join(d, "cells", r["id"], "inverse_stats.csv")):
-        if row["key"] == "operator_complexity":
-            return f"{float(row['value']):.2f}"
-    return "-"
+    return counters(d, r)[1]
 
 
 def spread(d):
