@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/fcr.h"
+#include "core/fcr4.h"
 #include "core/hessian_cell.h"
 #include "core/mat3.h"
 #include "core/reduce.h"
@@ -198,32 +199,61 @@ typedef struct {
     const double *dv;
 } EnergyArgs;
 
-/* Elastic energy of particles [begin, end); stores F(dv) and P(F) per particle. */
+/* dt (v_i + dv_i) of the stencil nodes, kept across the particles of a
+ * cell (they share their 27 nodes): slot s holds node id[s]'s value. */
+typedef struct {
+    int id[27];
+    double u[27][3];
+} NodeCache;
+
+/* F_p(dv) = F_p^n + dt sum_i (v_i + dv_i) a_ip^T (SPEC 3) into F, summed
+ * over the stencil in slot order (in registers: F may alias nothing). */
+static inline void gather_F(const StepProblem *pb, const double *dv, size_t k, NodeCache *nc, double *restrict Fout)
+{
+    const int *node = pb->st->node + 27 * k;
+    const double *a = pb->a + 81 * k, *vn = pb->grid->v;
+    double dt = pb->dt;
+    double F[9];
+    m3_copy(F, pb->parts->F + 9 * k);
+    for (int s = 0; s < 27; ++s) {
+        int i = node[s];
+        if (i < 0) continue;
+        double *u = nc->u[s];
+        if (nc->id[s] != i) {
+            nc->id[s] = i;
+            u[0] = dt * (vn[3 * i] + dv[3 * i]);
+            u[1] = dt * (vn[3 * i + 1] + dv[3 * i + 1]);
+            u[2] = dt * (vn[3 * i + 2] + dv[3 * i + 2]);
+        }
+        const double *as = a + 3 * s;
+        F[0] += u[0] * as[0]; F[1] += u[0] * as[1]; F[2] += u[0] * as[2];
+        F[3] += u[1] * as[0]; F[4] += u[1] * as[1]; F[5] += u[1] * as[2];
+        F[6] += u[2] * as[0]; F[7] += u[2] * as[1]; F[8] += u[2] * as[2];
+    }
+    m3_copy(Fout, F);
+}
+
+/* Elastic energy of particles [begin, end); stores F(dv) and P(F) per
+ * particle. Four particles at a time share the SIMD lanes of the SVD
+ * (core/fcr4.h); the sum keeps the particle order. */
 static double elastic_range(const void *ctx, size_t begin, size_t end)
 {
     const EnergyArgs *ea = ctx;
     StepProblem *pb = ea->pb;
-    const double *dv = ea->dv;
     const Particles *p = pb->parts;
-    const Stencils *st = pb->st;
-    const double *vn = pb->grid->v;
-    double dt = pb->dt, e = 0.0;
-    for (size_t k = begin; k < end; ++k) {
-        const int *node = st->node + 27 * k;
-        const double *a = pb->a + 81 * k;
-        double *F = pb->F + 9 * k;
-        m3_copy(F, p->F + 9 * k);
-        for (int s = 0; s < 27; ++s) {
-            int i = node[s];
-            if (i < 0) continue;
-            double u0 = dt * (vn[3 * i] + dv[3 * i]), u1 = dt * (vn[3 * i + 1] + dv[3 * i + 1]),
-                   u2 = dt * (vn[3 * i + 2] + dv[3 * i + 2]);
-            const double *as = a + 3 * s;
-            F[0] += u0 * as[0]; F[1] += u0 * as[1]; F[2] += u0 * as[2];
-            F[3] += u1 * as[0]; F[4] += u1 * as[1]; F[5] += u1 * as[2];
-            F[6] += u2 * as[0]; F[7] += u2 * as[1]; F[8] += u2 * as[2];
-        }
-        e += p->vol[k] * fcr_psi_P(F, pb->mu[k], pb->lambda[k], pb->P + 9 * k);
+    double e = 0.0;
+    NodeCache nc;
+    for (int s = 0; s < 27; ++s) nc.id[s] = -1;
+    size_t k = begin;
+    for (; k + 4 <= end; k += 4) {
+        for (int l = 0; l < 4; ++l) gather_F(pb, ea->dv, k + l, &nc, pb->F + 9 * (k + l));
+        double psi[4];
+        fcr_psi_P4(pb->F + 9 * k, pb->mu + k, pb->lambda + k, pb->P + 9 * k, psi, pb->stress_kernel);
+        for (int l = 0; l < 4; ++l) e += p->vol[k + l] * psi[l];
+    }
+    for (; k < end; ++k) {
+        gather_F(pb, ea->dv, k, &nc, pb->F + 9 * k);
+        e += p->vol[k] * fcr_psi_P(pb->F + 9 * k, pb->mu[k], pb->lambda[k], pb->P + 9 * k);
     }
     return e;
 }
