@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "core/fcr.h"
 #include "core/fcr4.h"
+#include "core/gradient_cell.h"
 #include "core/hessian_cell.h"
 #include "core/mat3.h"
 #include "core/reduce.h"
@@ -295,19 +296,27 @@ void problem_gradient(StepProblem *pb, const double *dv, double *grad)
 #pragma omp parallel for schedule(dynamic, 4)
         for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
             int q = pc->color_blocks[qi];
-            for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
+            int k = pc->block_start[q], kend = pc->block_start[q + 1];
+            while (k < kend) {
+                /* the particles of one cell (same base node) share their stencil */
+                const int *b0 = st->base + 3 * (size_t)k;
+                int k1 = k + 1;
+                while (k1 < kend && memcmp(st->base + 3 * (size_t)k1, b0, 3 * sizeof(int)) == 0) ++k1;
+                _Alignas(32) double f[GRADIENT_CELL_SIZE];
+                gradient_cell(k1 - k, pb->P + 9 * (size_t)k, p->F + 9 * (size_t)k, st->f1d + 18 * (size_t)k,
+                              p->vol + k, dt, f, pb->gradient_kernel);
+                /* node ids: the first particle's; where its weight is 0, another's */
                 const int *node = st->node + 27 * (size_t)k;
-                const double *a = pb->a + 81 * (size_t)k, *P = pb->P + 9 * (size_t)k;
-                double s = dt * p->vol[k];
                 for (int t = 0; t < 27; ++t) {
                     int i = node[t];
+                    for (int kk = k + 1; i < 0 && kk < k1; ++kk) i = st->node[27 * (size_t)kk + t];
                     if (i < 0) continue;
-                    double f[3];
-                    m3_mulv(P, a + 3 * t, f);
-                    grad[3 * i] += s * f[0];
-                    grad[3 * i + 1] += s * f[1];
-                    grad[3 * i + 2] += s * f[2];
+                    const double *ft = f + 12 * (t / 3) + t % 3;
+                    grad[3 * i] += ft[0];
+                    grad[3 * i + 1] += ft[4];
+                    grad[3 * i + 2] += ft[8];
                 }
+                k = k1;
             }
         }
     }

@@ -6,6 +6,8 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/fcr4.h"
+#include "core/gradient_cell.h"
 #include "core/hessian_cell.h"
 #include "core/step.h"
 #include "core/transfer.h"
@@ -161,13 +163,17 @@ static KernelModel model_energy(double nodes_per_particle, double tests, double 
     return m;
 }
 
-/* Gradient at the cached P: per node P a_ip (15), dt V_p (.) and the add (6)
- * -> 27 x 21 + 1; inertia and gravity 9 per node. Bytes: a_ip 648, P 72, node
- * ids 108, vol 8; dv and mass read, the gradient written (56 per node). */
-static KernelModel model_gradient(double nodes_per_particle)
+/* Gradient at the cached P, by cells (core/gradient_cell.c): per particle
+ * Q = dt V_p P F^nT (54); per node grad w_ip from its tensor factors (4),
+ * Q grad w (15) and the cell sum (3) -> 27 x 22; per cell the scatter (3 a
+ * node, 81 over the cell's particles); inertia and gravity 9 per node.
+ * Bytes: P, F^n 144, the factors of w 144, vol and base 20, node ids 108 a
+ * cell; dv and mass read, the gradient written (56 per node). */
+static KernelModel model_gradient(double nodes_per_particle, double particles_per_cell)
 {
-    KernelModel m = {"gradient (scatter of P)", 27.0 * 21.0 + 1.0 + 9.0 * nodes_per_particle,
-                     648.0 + 72.0 + 108.0 + 8.0 + 56.0 * nodes_per_particle};
+    KernelModel m = {"gradient (scatter of P)", 0, 0};
+    m.flops = 54.0 + 27.0 * 22.0 + 81.0 / particles_per_cell + 9.0 * nodes_per_particle;
+    m.bytes = 144.0 + 144.0 + 20.0 + 108.0 / particles_per_cell + 56.0 * nodes_per_particle;
     return m;
 }
 
@@ -287,11 +293,17 @@ int bench_run(const char *what, const RunConfig *cfg)
         for (int i = 0; i < 3 * n; ++i) bc.dv[i] += bc.y[i];
         double t = machine_best_time(run_energy, &bc, min_s, &spread);
         report(&L, model_energy(npp, ENERGY_SVD_TESTS, ENERGY_SVD_ROTATIONS), t, spread, "energy");
+        printf("energy_kernel_isa=%s\n", fcr4_isa());
     }
     if (all || !strcmp(what, "gradient")) {
         problem_energy(pb, bc.dv); /* the cache at dv */
         double t = machine_best_time(run_gradient, &bc, min_s, &spread);
-        report(&L, model_gradient(npp), t, spread, "gradient");
+        size_t cells = np > 0; /* runs of one base node */
+        for (size_t k = 1; k < np; ++k)
+            cells += memcmp(sim.st.base + 3 * k, sim.st.base + 3 * (k - 1), 3 * sizeof(int)) != 0;
+        report(&L, model_gradient(npp, cells ? (double)np / (double)cells : 1.0), t, spread, "gradient");
+        printf("gradient_kernel_isa=%s\ngradient_particles_per_cell=%.2f\n", gradient_cell_isa(),
+               cells ? (double)np / (double)cells : 0.0);
     }
     if (all || !strcmp(what, "p2g")) {
         double t = machine_best_time(run_p2g, &bc, min_s, &spread);

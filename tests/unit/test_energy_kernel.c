@@ -1,26 +1,29 @@
 /* The line search's kernels: problem_energy (F(dv), SVD, psi, P per particle,
- * four particles in SIMD lanes, core/fcr4.h) and problem_gradient, for every
- * variant the dispatch can choose (FCR4_AUTO: AVX where the CPU has it, and
- * FCR4_PORTABLE):
+ * four particles in SIMD lanes, core/fcr4.h) and problem_gradient (by cells,
+ * core/gradient_cell.h), for every variant the dispatch can choose (AUTO:
+ * AVX, AVX2+FMA where the CPU has them; PORTABLE):
  *  - fcr_psi_P4 against fcr_psi_P lane by lane, bit for bit (same operations
  *    in the same order, no FMA), on near-identity, large, inverted,
  *    rank-deficient, zero, huge, tiny and NaN inputs;
  *  - on a scene's first step (bar3) and on the two-material fixture (with
- *    inverted particles and Dirichlet nodes), energy and gradient at a
- *    perturbed dv against plain triple loops written here from the formulas
- *    (SPEC 3): a_ip = F^nT grad w_ip, F = F^n + dt sum_i (v_i + dv_i) a_ip^T,
- *    psi and P by fcr_psi_P, E = sum_i m_i (|dv_i|^2/2 - dt g.dv_i) + sum_p V_p
- *    psi_p, g_i = m_i (dv_i - dt g) + dt sum_p V_p P_p a_ip, projected.
+ *    inverted particles and Dirichlet nodes, B-spline and MLS gradients),
+ *    energy and gradient at a perturbed dv against plain triple loops written
+ *    here from the formulas (SPEC 3): a_ip = F^nT grad w_ip,
+ *    F = F^n + dt sum_i (v_i + dv_i) a_ip^T, psi and P by fcr_psi_P,
+ *    E = sum_i m_i (|dv_i|^2/2 - dt g.dv_i) + sum_p V_p psi_p,
+ *    g_i = m_i (dv_i - dt g) + dt sum_p V_p P_p a_ip, projected.
  *    Bounds: the cached F_p and P_p equal the reference's bit for bit (the
- *    same sums in the same order); E and g differ only by summation order, so
- *    |E - E_ref| <= 1e-13 sum |terms| and |g_ic - g_ref,ic| <= 1e-13 sum_terms
- *    |.| per node: recursive summation of N terms errs by at most
- *    N u sum |terms| (u = 2^-53), and N here is at most ~ 600 (reduce_sum's
- *    chunk of 64 plus at most 1024 chunk sums is larger, 1088 u = 1.2e-13, but
- *    its chunks here number < 100: 164 u = 1.8e-14; a node has at most 27 x 8
- *    x 4 particle contributions and 2 inertial ones: 866 u = 9.6e-14). The
- *    reference sums in extended precision (long double) so its own error is
- *    below that. */
+ *    same sums in the same order). E differs only by summation order; g by
+ *    summation order and by forming (P F^nT) grad w for P (F^nT grad w)
+ *    (with FMA in the AVX2 variant). So |E - E_ref| <= 1e-13 sum |terms|, and
+ *    |g_ic - g_ref,ic| <= 1e-13 (sum of the node's |inertial terms| +
+ *    sum_p |dt V_p| |P_p| |F_p^nT| |grad w_ip|): recursive summation of N
+ *    terms errs by at most N u sum |terms| (u = 2^-53, products of three
+ *    factors add a few u), and N is a few hundred here: reduce_sum adds
+ *    chunks of 64 particles in order and < 100 chunk sums at this size
+ *    (164 u = 1.8e-14); a node gathers the particles of the 27 cells around
+ *    it (~8 a cell: ~220 terms, 2.4e-14). The reference sums in long double,
+ *    so its own error is below that. */
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -29,6 +32,7 @@
 
 #include "core/fcr.h"
 #include "core/fcr4.h"
+#include "core/gradient_cell.h"
 #include "core/problem.h"
 #include "tests/common/fixture.h"
 #include "tests/common/testutil.h"
@@ -157,10 +161,14 @@ static void reference(StepProblem *pb, const double *dv, Reference *R)
         for (int s = 0; s < 27; ++s) {
             int i = node[s];
             if (i < 0) continue;
+            double abar[3]; /* |F^nT| |grad w| */
+            for (int b = 0; b < 3; ++b)
+                abar[b] = fabs(Fn[b] * dw[3 * s]) + fabs(Fn[3 + b] * dw[3 * s + 1]) + fabs(Fn[6 + b] * dw[3 * s + 2]);
             for (int r = 0; r < 3; ++r) {
                 double f = sc * (P[3 * r] * a[s][0] + P[3 * r + 1] * a[s][1] + P[3 * r + 2] * a[s][2]);
                 g[3 * (size_t)i + r] += f;
-                R->gscale[3 * (size_t)i + r] += fabs(f);
+                R->gscale[3 * (size_t)i + r] +=
+                    fabs(sc) * (fabs(P[3 * r]) * abar[0] + fabs(P[3 * r + 1]) * abar[1] + fabs(P[3 * r + 2]) * abar[2]);
             }
         }
     }
@@ -191,6 +199,7 @@ static void check_problem(StepProblem *pb, const char *what)
     reference(pb, dv, &R);
     for (int kernel = FCR4_AUTO; kernel <= FCR4_PORTABLE; ++kernel) {
         pb->stress_kernel = kernel;
+        pb->gradient_kernel = kernel;
         double E = problem_energy(pb, dv);
         problem_gradient(pb, dv, g);
         long fbad = 0, pbad = 0;
@@ -203,9 +212,10 @@ static void check_problem(StepProblem *pb, const char *what)
             if (R.gscale[e] > 0.0) gerr = fmax(gerr, fabs(g[e] - R.g[e]) / R.gscale[e]);
             else if (g[e] != 0.0 || R.g[e] != 0.0) gerr = INFINITY;
         double eerr = fabs(E - R.E) / R.Escale;
-        printf("%s (%zu particles, %d nodes), kernel %s: F, P differ in %ld, %ld entries; energy %.17g, "
+        printf("%s (%zu particles, %d nodes), kernels %s, %s: F, P differ in %ld, %ld entries; energy %.17g, "
                "error %.2e of sum|terms|; gradient error %.2e of sum|terms|\n",
-               what, np, n, kernel == FCR4_AUTO ? fcr4_isa() : "portable", fbad, pbad, E, eerr, gerr);
+               what, np, n, kernel == FCR4_AUTO ? fcr4_isa() : "portable",
+               kernel == GRADIENT_CELL_AUTO ? gradient_cell_isa() : "portable", fbad, pbad, E, eerr, gerr);
         CHECK(fbad == 0 && pbad == 0, "%s kernel %d: F_p, P_p differ from the reference in %ld, %ld entries", what,
               kernel, fbad, pbad);
         CHECK(eerr <= 1e-13, "%s kernel %d: energy %.17g vs reference %.17g (%.2e of sum|terms|)", what, kernel, E,
@@ -213,6 +223,7 @@ static void check_problem(StepProblem *pb, const char *what)
         CHECK(gerr <= 1e-13, "%s kernel %d: gradient error %.2e of sum|terms|", what, kernel, gerr);
     }
     pb->stress_kernel = FCR4_AUTO;
+    pb->gradient_kernel = GRADIENT_CELL_AUTO;
     free(R.g), free(R.gscale), free(R.F), free(R.P);
     free(dv), free(d), free(g);
 }
