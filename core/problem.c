@@ -353,23 +353,59 @@ static inline void contract_right(const double B[27], const double at[3], double
         }
 }
 
+/* The offsets (s, t) a particle touching every node of its stencil adds to
+ * row s's neighbour mask, for each s. */
+static void full_stencil_masks(uint64_t full[27][2])
+{
+    for (int s = 0; s < 27; ++s) {
+        full[s][0] = full[s][1] = 0;
+        for (int t = 0; t < 27; ++t) {
+            int o = g_pair_offset[s][t];
+            full[s][o >> 6] |= 1ull << (o & 63);
+        }
+    }
+}
+
 static int build_pattern(StepProblem *pb, Bsr *H)
 {
     const Stencils *st = pb->st;
     const Grid *g = pb->grid;
     int n = pb->n_nodes;
     memset(pb->rowmask, 0, sizeof(uint64_t) * 2 * (size_t)n);
+    uint64_t full[27][2];
+    full_stencil_masks(full);
     const NodeColoring *pc = &st->pcolor;
     for (int c = 0; c < MPM_NUM_COLORS; ++c) {
 #pragma omp parallel for schedule(dynamic, 4)
         for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
             int q = pc->color_blocks[qi];
-            for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
-                const int *node = st->node + 27 * (size_t)k;
+            /* one pass per cell, not per particle: the particles of a cell
+             * (same base node, consecutive, the runs problem_assemble sums)
+             * share their 27 nodes, and the pattern holds every pair of the
+             * cell's node union, the blocks scatter_cell adds to (a node is
+             * missing from a particle's stencil only where its weight is
+             * exactly 0) */
+            int k = pc->block_start[q], kend = pc->block_start[q + 1];
+            while (k < kend) {
+                const int *b0 = st->base + 3 * (size_t)k;
+                int node[27];
+                memcpy(node, st->node + 27 * (size_t)k, sizeof node);
+                int k1 = k + 1;
+                for (; k1 < kend && memcmp(st->base + 3 * (size_t)k1, b0, 3 * sizeof(int)) == 0; ++k1)
+                    for (int t = 0; t < 27; ++t)
+                        if (node[t] < 0) node[t] = st->node[27 * (size_t)k1 + t];
+                k = k1;
+                int all = 1;
+                for (int t = 0; t < 27; ++t) all &= node[t] >= 0;
                 for (int s = 0; s < 27; ++s) {
                     int i = node[s];
                     if (i < 0) continue;
                     uint64_t *rm = pb->rowmask + 2 * (size_t)i;
+                    if (all) {
+                        rm[0] |= full[s][0];
+                        rm[1] |= full[s][1];
+                        continue;
+                    }
                     for (int t = 0; t < 27; ++t) {
                         if (node[t] < 0) continue;
                         int o = g_pair_offset[s][t];

@@ -1,5 +1,6 @@
 #include "tests/common/fixture.h"
 
+#include <math.h>
 #include <string.h>
 
 #include "core/mat3.h"
@@ -41,6 +42,10 @@ int fixture_build(Fixture *f, const FixtureOptions *o)
                 double x[3] = {origin + (i + 0.5 + 0.3 * test_uniform(&rs, -1, 1)) * o->spacing,
                                origin + (j + 0.5 + 0.3 * test_uniform(&rs, -1, 1)) * o->spacing,
                                origin + (k + 0.5 + 0.3 * test_uniform(&rs, -1, 1)) * o->spacing};
+                if (o->snap_to_centre) {
+                    int d = (int)test_uniform(&rs, 0, 3) % 3;
+                    x[d] = (floor(x[d] / o->dx) + 0.5) * o->dx;
+                }
                 double v[3];
                 for (int d = 0; d < 3; ++d) v[d] = o->v_noise * test_uniform(&rs, -1, 1);
                 int mat = o->two_materials ? (i >= o->per_axis / 2) : 0;

@@ -30,6 +30,8 @@ typedef struct {
     double gravity[3];
     unsigned long long seed;
     int mls;             /* 1: MLS-MPM gradients (stencils_use_mls_gradients) and the fused P2G */
+    int snap_to_centre;  /* 1: one coordinate of each particle, at random, at its cell's centre: the
+                          * far node's weight in that axis is exactly 0 (needs dx a power of 2) */
 } FixtureOptions;
 
 /* The first step problem of a built-in scene (or scene file) at --scale,

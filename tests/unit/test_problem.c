@@ -270,6 +270,78 @@ static void test_cn_single_material(void)
     fixture_free(&f);
 }
 
+/* The Hessian's pattern is, per cell (a run of particles with one base
+ * node), every pair of the cell's node union: what the assembly's cell
+ * scatter adds to. With every particle's far node in one axis at weight
+ * exactly 0, some cells hold node pairs no single particle touches; the
+ * pattern must hold those too (they receive exact zeros) and nothing else. */
+static void test_pattern_cell_union(void)
+{
+    FixtureOptions o;
+    fixture_default(&o);
+    o.dx = 0.125; /* cell centres exact in binary */
+    o.per_axis = 8;
+    o.snap_to_centre = 1;
+    Fixture f;
+    CHECK(fixture_build(&f, &o) == 0, "fixture");
+    int n = f.pb.n_nodes;
+    const Stencils *st = &f.st;
+    char *ref = calloc((size_t)n * (size_t)n, 1), *single = calloc((size_t)n * (size_t)n, 1);
+    int missing_nodes = 0;
+    const NodeColoring *pc = &st->pcolor;
+    for (int q = 0; q < pc->n_blocks; ++q) {
+        int k = pc->block_start[q], kend = pc->block_start[q + 1];
+        while (k < kend) {
+            int k1 = k, node[27];
+            for (int t = 0; t < 27; ++t) node[t] = -1;
+            for (; k1 < kend && memcmp(st->base + 3 * (size_t)k1, st->base + 3 * (size_t)k, 3 * sizeof(int)) == 0; ++k1) {
+                const int *nk = st->node + 27 * (size_t)k1;
+                for (int s = 0; s < 27; ++s) {
+                    missing_nodes += nk[s] < 0;
+                    if (nk[s] >= 0) node[s] = nk[s];
+                    for (int t = 0; t < 27; ++t)
+                        if (nk[s] >= 0 && nk[t] >= 0) single[(size_t)nk[s] * n + nk[t]] = 1;
+                }
+            }
+            for (int s = 0; s < 27; ++s)
+                for (int t = 0; t < 27; ++t)
+                    if (node[s] >= 0 && node[t] >= 0) ref[(size_t)node[s] * n + node[t]] = 1;
+            k = k1;
+        }
+    }
+    size_t only_union = 0, nref = 0;
+    for (size_t e = 0; e < (size_t)n * n; ++e) {
+        nref += ref[e];
+        only_union += ref[e] && !single[e];
+    }
+    CHECK(missing_nodes > 0 && only_union > 0, "the fixture exercises zero weights (%d missing stencil nodes) and pairs "
+          "of a cell no particle touches (%zu)", missing_nodes, only_union);
+    double *dv = alloc3(n), *x = alloc3(n), *y1 = alloc3(n), *y2 = alloc3(n);
+    unsigned long long rs = 9;
+    random_vec(n, dv, &rs, 0.05);
+    random_vec(n, x, &rs, 1.0);
+    problem_energy(&f.pb, dv);
+    problem_tangent(&f.pb, 1);
+    Bsr H = {0};
+    CHECK(problem_assemble(&f.pb, &H) == 0, "assemble");
+    size_t wrong = 0;
+    for (int i = 0; i < H.n; ++i)
+        for (int64_t k = H.row_ptr[i]; k < H.row_ptr[i + 1]; ++k) wrong += !ref[(size_t)i * n + H.col[k]];
+    CHECK(wrong == 0 && (size_t)H.nnzb == nref, "pattern = the cells' node-union pairs: %lld blocks, %zu expected, %zu "
+          "not expected", (long long)H.nnzb, nref, wrong);
+    bsr_spmv(&H, x, y1);
+    problem_hessvec(&f.pb, x, y2);
+    double err = 0, nrm = 0;
+    for (size_t i = 0; i < 3 * (size_t)n; ++i) {
+        err += (y1[i] - y2[i]) * (y1[i] - y2[i]);
+        nrm += y1[i] * y1[i];
+    }
+    CHECK(sqrt(err / nrm) < 1e-14, "zero weights: assembled vs matrix-free rel diff %.3e", sqrt(err / nrm));
+    bsr_free(&H);
+    free(ref), free(single), free(dv), free(x), free(y1), free(y2);
+    fixture_free(&f);
+}
+
 int main(void)
 {
     for (int mls = 0; mls <= 1; ++mls) { /* B-spline gradients, then the MLS substitute (SPEC 9) */
@@ -282,5 +354,6 @@ int main(void)
         test_projected_hessian_spd(0, 0.0, "near-degenerate", mls);
     }
     test_cn_single_material();
+    test_pattern_cell_union();
     return test_summary("test_problem");
 }
