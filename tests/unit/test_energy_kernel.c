@@ -6,7 +6,8 @@
  *    in the same order, no FMA), on near-identity, large, inverted,
  *    rank-deficient, zero, huge, tiny and NaN inputs;
  *  - on a scene's first step (bar3) and on the two-material fixture (with
- *    inverted particles and Dirichlet nodes, B-spline and MLS gradients),
+ *    inverted particles and Dirichlet nodes, B-spline and MLS gradients, and
+ *    with zero-weight stencil nodes that differ within a cell),
  *    energy and gradient at a perturbed dv against plain triple loops written
  *    here from the formulas (SPEC 3): a_ip = F^nT grad w_ip,
  *    F = F^n + dt sum_i (v_i + dv_i) a_ip^T, psi and P by fcr_psi_P,
@@ -248,10 +249,18 @@ static void mark_some(StepProblem *pb)
     problem_finish_dirichlet(pb);
 }
 
-static void test_fixture(int mls)
+/* snap: one coordinate of each particle at its cell's centre, so a node of
+ * its stencil has weight exactly 0 (id -1), a different one per particle
+ * of a cell: the cell scatter must take those nodes' ids from the others. */
+static void test_fixture(int mls, int snap)
 {
     FixtureOptions o;
     fixture_default(&o);
+    if (snap) {
+        o.dx = 0.125; /* cell centres exact in binary */
+        o.per_axis = 8;
+        o.snap_to_centre = 1;
+    }
     o.two_materials = 1;
     o.inverted_fraction_pct = 10;
     o.F_noise = 0.3;
@@ -260,7 +269,12 @@ static void test_fixture(int mls)
     Fixture f;
     CHECK(fixture_build(&f, &o) == 0, "fixture");
     mark_some(&f.pb);
-    check_problem(&f.pb, mls ? "fixture (MLS)" : "fixture");
+    long zero = 0;
+    for (size_t e = 0; e < 27 * f.st.n; ++e) zero += f.st.node[e] < 0;
+    if (snap) CHECK(zero > 0, "snap_to_centre: no zero-weight node");
+    char what[64];
+    snprintf(what, sizeof what, "fixture%s%s (%ld zero weights)", mls ? " MLS" : "", snap ? " snapped" : "", zero);
+    check_problem(&f.pb, what);
     fixture_free(&f);
 }
 
@@ -268,7 +282,9 @@ int main(void)
 {
     for (int kernel = FCR4_AUTO; kernel <= FCR4_PORTABLE; ++kernel) test_lanes(kernel);
     test_scene();
-    test_fixture(0);
-    test_fixture(1);
+    for (int snap = 0; snap <= 1; ++snap) {
+        test_fixture(0, snap);
+        test_fixture(1, snap);
+    }
     return test_summary("test_energy_kernel");
 }
