@@ -302,6 +302,10 @@ void problem_gradient(StepProblem *pb, const double *dv, double *grad)
                 const int *b0 = st->base + 3 * (size_t)k;
                 int k1 = k + 1;
                 while (k1 < kend && memcmp(st->base + 3 * (size_t)k1, b0, 3 * sizeof(int)) == 0) ++k1;
+                /* the next cell's node ids, read only at its scatter (a
+                 * cell's particles between: no hardware stream covers them) */
+                __builtin_prefetch(st->node + 27 * (size_t)k1);
+                __builtin_prefetch(st->node + 27 * (size_t)k1 + 16);
                 _Alignas(32) double f[GRADIENT_CELL_SIZE];
                 gradient_cell(k1 - k, pb->P + 9 * (size_t)k, p->F + 9 * (size_t)k, st->f1d + 18 * (size_t)k,
                               p->vol + k, dt, f, pb->gradient_kernel);
