@@ -43,21 +43,22 @@ void bsr_update_pattern_id(Bsr *A)
     A->pattern_id = h;
 }
 
-/* (A x)_i for block row i: three running sums over the row's 3x3 blocks. */
+/* (A x)_i for block row i, on the doubles of A->val and on a single-precision
+ * copy of them (core/bsr_row_product.inc, one body for both). */
+#define BSR_VAL double
+#define BSR_ROW_PRODUCT row_product_vals
+#include "core/bsr_row_product.inc"
+#undef BSR_VAL
+#undef BSR_ROW_PRODUCT
+#define BSR_VAL float
+#define BSR_ROW_PRODUCT row_product_single
+#include "core/bsr_row_product.inc"
+#undef BSR_VAL
+#undef BSR_ROW_PRODUCT
+
 static inline void row_product(const Bsr *A, int i, const double *restrict x, double out[3])
 {
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
-    for (int64_t k = A->row_ptr[i]; k < A->row_ptr[i + 1]; ++k) {
-        const double *b = A->val + 9 * k;
-        const double *xj = x + 3 * (size_t)A->col[k];
-        double x0 = xj[0], x1 = xj[1], x2 = xj[2];
-        s0 += b[0] * x0 + b[1] * x1 + b[2] * x2;
-        s1 += b[3] * x0 + b[4] * x1 + b[5] * x2;
-        s2 += b[6] * x0 + b[7] * x1 + b[8] * x2;
-    }
-    out[0] = s0;
-    out[1] = s1;
-    out[2] = s2;
+    row_product_vals(A, A->val, i, x, out);
 }
 
 void bsr_spmv(const Bsr *A, const double *restrict x, double *restrict y)
@@ -76,6 +77,33 @@ void bsr_spmv_sub(const Bsr *A, const double *restrict x, double *restrict r)
         r[3 * (size_t)i + 1] -= s[1];
         r[3 * (size_t)i + 2] -= s[2];
     }
+}
+
+void bsr_spmv_sub_single(const Bsr *A, const float *val, const double *restrict x, double *restrict r)
+{
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < A->n; ++i) {
+        double s[3];
+        row_product_single(A, val, i, x, s);
+        r[3 * (size_t)i] -= s[0];
+        r[3 * (size_t)i + 1] -= s[1];
+        r[3 * (size_t)i + 2] -= s[2];
+    }
+}
+
+int bsr_values_single(const Bsr *A, float **val, int64_t *cap)
+{
+    if (A->nnzb > *cap) {
+        float *v = realloc(*val, sizeof(float) * 9 * (size_t)A->nnzb);
+        if (!v) return mpm_error(MPM_EINTERNAL, "out of memory: single-precision block values (%lld)", (long long)A->nnzb);
+        *val = v;
+        *cap = A->nnzb;
+    }
+    float *restrict out = *val;
+    const size_t len = 9 * (size_t)A->nnzb;
+#pragma omp parallel for schedule(static)
+    for (size_t e = 0; e < len; ++e) out[e] = (float)A->val[e];
+    return MPM_OK;
 }
 
 int64_t bsr_find(const Bsr *A, int row, int col)

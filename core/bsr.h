@@ -30,6 +30,12 @@ void bsr_update_pattern_id(Bsr *A);
 void bsr_spmv(const Bsr *A, const double *x, double *y);
 /* r -= A x (row-parallel). */
 void bsr_spmv_sub(const Bsr *A, const double *x, double *r);
+/* Single-precision copy of A's values (9 nnzb floats, *val grown to fit,
+ * *cap its blocks): a bandwidth-halving operand for smoothers (SPEC 6.10). */
+int bsr_values_single(const Bsr *A, float **val, int64_t *cap);
+/* r -= A_s x with A_s the single-precision values `val` on A's pattern
+ * (products and sums in double). */
+void bsr_spmv_sub_single(const Bsr *A, const float *val, const double *x, double *r);
 /* Index of block (row, col) or -1 (binary search in the sorted row). */
 int64_t bsr_find(const Bsr *A, int row, int col);
 /* Copies the diagonal blocks into diag (9n). Missing diagonal -> zero block. */

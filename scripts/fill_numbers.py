@@ -326,6 +326,21 @@ def fig18_speedup(scene, solver="gast15"):
     return sig(num(one("gast15-fig18", scene=scene, solver=solver), "speedup_total"))
 
 
+def paper_scenes():
+    """Scenes of the paper-scale matrix with every solver's cell present."""
+    rows = [r for r in table("paper-scale", "cells.csv") if r.get("role", "") != "reference"]
+    solvers = {r["solver"] for r in rows}
+    by = {}
+    for r in rows:
+        by.setdefault(r["scene"], set()).add(r["solver"])
+    return [sc for sc, s in by.items() if s == solvers]
+
+
+def paper_particles():
+    parts = [num(r, "particles") for r in table("paper-scale", "cells.csv") if r["scene"] in paper_scenes()]
+    return f"{grouped(min(parts))} to {grouped(max(parts))}"
+
+
 def table1_ratio(scene, slow, fast):
     a = num(one("gast15-table1", scene=scene, solver=slow), "s_per_frame")
     b = num(one("gast15-table1", scene=scene, solver=fast), "s_per_frame")
@@ -427,6 +442,13 @@ NUMBERS = {
     "base.lead_1t": lambda: baselines_lead(1),
     "base.lead_1t_range": lambda: baselines_lead(1, "range"),
     "mls.time_ratio_pn-pcg": lambda: mls_time_ratio("pn-pcg"),
+    "paper.cells": lambda: cells_ok("paper-scale"),
+    "paper.date": lambda: run_date("paper-scale"),
+    "paper.n_scenes": lambda: str(len(paper_scenes())),
+    "paper.particles": paper_particles,
+    "paper.hot_geomean": lambda: geomean("paper-scale", "hot"),
+    "paper.hot_range": lambda: speedup_range("paper-scale", "hot"),
+    "paper.mf_geomean": lambda: geomean("paper-scale", "pn-pcg-mf"),
     "fig18.cells": lambda: cells_ok("gast15-fig18"),
     "fig18.date": lambda: run_date("gast15-fig18"),
     "fig18.gast15_vs_semi_drop": lambda: fig18_speedup("snowball-drop"),

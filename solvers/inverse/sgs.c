@@ -10,93 +10,28 @@
 #include "core/vec.h"
 #include "solvers/inverse/jacobi.h"
 
-/* acc = sum_{j != i} A_ij x_j over the stored row i, in column order. */
-static inline void row_offdiag_sum(const Bsr *A, int i, const double *x, double acc[3])
+/* The sweep on the doubles of A->val and on a single-precision copy of them
+ * (solvers/inverse/sgs_sweep.inc, one body for both). */
+#define SGS_VAL double
+#define SGS_NAME(x) x##_f64
+#include "solvers/inverse/sgs_sweep.inc"
+#undef SGS_VAL
+#undef SGS_NAME
+#define SGS_VAL float
+#define SGS_NAME(x) x##_f32
+#include "solvers/inverse/sgs_sweep.inc"
+#undef SGS_VAL
+#undef SGS_NAME
+
+int sgs_sweep(const Bsr *A, const double *Dinv, const NodeColoring *col, const double *r, double *delta, double *work)
 {
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
-    for (int64_t k = A->row_ptr[i]; k < A->row_ptr[i + 1]; ++k) {
-        int j = A->col[k];
-        if (j == i) continue;
-        const double *b = A->val + 9 * k;
-        const double *xj = x + 3 * (size_t)j;
-        double x0 = xj[0], x1 = xj[1], x2 = xj[2];
-        s0 += b[0] * x0 + b[1] * x1 + b[2] * x2;
-        s1 += b[3] * x0 + b[4] * x1 + b[5] * x2;
-        s2 += b[6] * x0 + b[7] * x1 + b[8] * x2;
-    }
-    acc[0] = s0;
-    acc[1] = s1;
-    acc[2] = s2;
+    return sweep_f64(A, A->val, Dinv, col, r, delta, work);
 }
 
-/* Same sum with the row walked from its end: the backward pass visits rows
- * in decreasing order, and a fully descending walk streams well. */
-static inline void row_offdiag_sum_rev(const Bsr *A, int i, const double *x, double acc[3])
+int sgs_sweep_single(const Bsr *A, const float *val, const double *Dinv, const NodeColoring *col, const double *r,
+                     double *delta, double *work)
 {
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
-    for (int64_t k = A->row_ptr[i + 1] - 1; k >= A->row_ptr[i]; --k) {
-        int j = A->col[k];
-        if (j == i) continue;
-        const double *b = A->val + 9 * k;
-        const double *xj = x + 3 * (size_t)j;
-        double x0 = xj[0], x1 = xj[1], x2 = xj[2];
-        s0 += b[0] * x0 + b[1] * x1 + b[2] * x2;
-        s1 += b[3] * x0 + b[4] * x1 + b[5] * x2;
-        s2 += b[6] * x0 + b[7] * x1 + b[8] * x2;
-    }
-    acc[0] = s0;
-    acc[1] = s1;
-    acc[2] = s2;
-}
-
-int sgs_sweep(const Bsr *A, const double *Dinv, const NodeColoring *col, const double *r, double *delta,
-              double *work)
-{
-    const int n = A->n;
-    const size_t len = 3 * (size_t)n;
-    double *h = work, *s = work + len;
-    vec_zero(len, h);
-    vec_zero(len, delta);
-#pragma omp parallel
-    {
-        /* Forward: h_i = D_i^-1 (r_i - sum_{j before i} A_ij h_j); keep
-         * s_i = D_i h_i (the scaling step, without the round-off of
-         * multiplying D_i back). */
-        for (int c = 0; c < MPM_NUM_COLORS; ++c) {
-#pragma omp for schedule(dynamic, 4)
-            for (int bi = col->color_start[c]; bi < col->color_start[c + 1]; ++bi) {
-                int b = col->color_blocks[bi];
-                for (int i = col->block_start[b]; i < col->block_start[b + 1]; ++i) {
-                    double acc[3];
-                    row_offdiag_sum(A, i, h, acc);
-                    double *si = s + 3 * (size_t)i;
-                    const double *ri = r + 3 * (size_t)i;
-                    si[0] = ri[0] - acc[0];
-                    si[1] = ri[1] - acc[1];
-                    si[2] = ri[2] - acc[2];
-                    m3_mulv(Dinv + 9 * (size_t)i, si, h + 3 * (size_t)i);
-                }
-            }
-        }
-        /* Backward: colours 7..0, nodes in reverse:
-         * delta_i = D_i^-1 (s_i - sum_{j after i} A_ij delta_j). */
-        for (int c = MPM_NUM_COLORS - 1; c >= 0; --c) {
-#pragma omp for schedule(dynamic, 4)
-            for (int bi = col->color_start[c + 1] - 1; bi >= col->color_start[c]; --bi) {
-                int b = col->color_blocks[bi];
-                for (int i = col->block_start[b + 1] - 1; i >= col->block_start[b]; --i) {
-                    double acc[3], t[3];
-                    row_offdiag_sum_rev(A, i, delta, acc);
-                    const double *si = s + 3 * (size_t)i;
-                    t[0] = si[0] - acc[0];
-                    t[1] = si[1] - acc[1];
-                    t[2] = si[2] - acc[2];
-                    m3_mulv(Dinv + 9 * (size_t)i, t, delta + 3 * (size_t)i);
-                }
-            }
-        }
-    }
-    return MPM_OK;
+    return sweep_f32(A, val, Dinv, col, r, delta, work);
 }
 
 int sgs_check_coloring(const Bsr *A, const NodeColoring *col)

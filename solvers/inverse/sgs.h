@@ -26,6 +26,11 @@
 int sgs_sweep(const Bsr *A, const double *Dinv, const NodeColoring *col, const double *r, double *delta,
               double *work);
 
+/* The same sweep with the blocks read from `val`, a single-precision copy
+ * of A's values (bsr_values_single); Dinv stays double (SPEC 6.10). */
+int sgs_sweep_single(const Bsr *A, const float *val, const double *Dinv, const NodeColoring *col, const double *r,
+                     double *delta, double *work);
+
 /* Checks the colouring premise: no block of A couples two nodes lying in
  * different 4x4x4 blocks of the same colour (MPM_EINTERNAL if one does).
  * O(nnz); used by tests and debug checks. */

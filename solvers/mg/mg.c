@@ -27,6 +27,7 @@ typedef struct {
     double avg_row[MG_MAX_LEVELS];     /* nonzero blocks per row, mean */
     int max_row[MG_MAX_LEVELS];        /* and max */
     double transfer_s, galerkin_s, diag_s; /* parts of the last setup (its whole time: InvStats) */
+    double single_s;                   /* single-precision copies (smoother_precision=single) */
     long vcycles, coarse_iters, coarse_capped; /* since the last setup */
     double smooth_s[MG_MAX_LEVELS];    /* apply time split, since the last setup */
     double transfer_apply_s, coarse_s;
@@ -43,6 +44,8 @@ typedef struct {
     double *diagown, *dinv;
     MgTransfer T;          /* to level l+1 */
     double *r, *u, *d, *work; /* 3n, 3n, 3n, 6n */
+    float *valf;           /* smoother_precision=single: A's values in single precision (levels that smooth) */
+    int64_t capf;
     int cap;               /* nodes the per-level arrays hold */
 } MgLevel;
 
@@ -57,6 +60,7 @@ typedef struct {
     InvApprox base;
     MgEmbedding kind;
     int max_levels, sweeps, min_coarse, coarse_max_iters;
+    int single;                  /* smoother_precision=single (SPEC 6.10) */
     double coarse_tol;
     int nlev;
     MgLevel lev[MG_MAX_LEVELS];
@@ -112,6 +116,13 @@ static int mg_create(SolverOptions *opt, InvApprox **out)
     int cmax = solver_opt_int(opt, "coarse_max_iters", 10000, 1, 1000000000, &st);
     int exact = solver_opt_int(opt, "coarse_exact", 0, 0, 1, &st);
     int flexible = solver_opt_int(opt, "flexible", 1, 0, 1, &st);
+    int single = 0;
+    if (!st) { /* the matrix the smoother and the residual updates read (SPEC 6.10) */
+        const char *prec = solver_opt_string(opt, "smoother_precision", "double");
+        if (!strcmp(prec, "single")) single = 1;
+        else if (strcmp(prec, "double") != 0)
+            st = mpm_error(MPM_EINPUT, "solver option smoother_precision=%s: expected double or single", prec);
+    }
     /* only where it applies, so that a misplaced option is reported as unknown */
     int bc_project = rediscretize ? solver_opt_int(opt, "coarse_bc_project", 1, 0, 1, &st) : 0;
     MgEmbedding kind = MG_EMBED_LINEAR;
@@ -131,6 +142,7 @@ static int mg_create(SolverOptions *opt, InvApprox **out)
     M->gmg_bc_project = bc_project;
     M->max_levels = levels;
     M->sweeps = sweeps;
+    M->single = single;
     M->min_coarse = minc;
     M->coarse_tol = exact ? 1e-12 : ctol;
     M->coarse_max_iters = cmax;
@@ -158,6 +170,30 @@ static void fill_level_info(Mg *M, int l)
     M->info.nnzb[l] = A->nnzb;
     M->info.avg_row[l] = A->n ? (double)A->nnzb / A->n : 0.0;
     M->info.max_row[l] = mx;
+}
+
+/* smoother_precision=single: the single-precision values of levels
+ * from..nlev-2 (the coarsest level does not smooth: its PCG reads the
+ * doubles). Called whenever such a level's matrix changes. */
+static int single_copies(Mg *M, int from)
+{
+    if (!M->single) return MPM_OK;
+    double t0 = omp_get_wtime();
+    for (int l = from; l < M->nlev - 1; ++l) {
+        MgLevel *L = &M->lev[l];
+        int st = bsr_values_single(L->A, &L->valf, &L->capf);
+        if (st) return st;
+    }
+    M->info.single_s += omp_get_wtime() - t0;
+    return MPM_OK;
+}
+
+/* r -= A x on level l, with the matrix the smoother reads */
+static void level_residual(const Mg *M, int l, const double *x, double *r)
+{
+    const MgLevel *L = &M->lev[l];
+    if (M->single) bsr_spmv_sub_single(L->A, L->valf, x, r);
+    else bsr_spmv_sub(L->A, x, r);
 }
 
 /* Galerkin products and block-diagonal inverses of levels from..nlev-1
@@ -207,8 +243,15 @@ static int mg_reuse(InvApprox *self, const InvSetupInput *in, int values, int *r
         if ((st = mg_galerkin_levels(M, 1))) return st;
         for (int l = 0; l < M->nlev; ++l) fill_level_info(M, l);
         *refreshed = 1;
+        return single_copies(M, 0);
     }
-    return MPM_OK;
+    /* the fine level has the new H; the coarser copies are kept with their levels */
+    if (M->single && M->nlev > 1) {
+        double t0 = omp_get_wtime();
+        st = bsr_values_single(L0->A, &L0->valf, &L0->capf);
+        M->info.single_s += omp_get_wtime() - t0;
+    }
+    return st;
 }
 
 static int mg_setup(InvApprox *self, const InvSetupInput *in)
@@ -277,7 +320,7 @@ static int mg_setup(InvApprox *self, const InvSetupInput *in)
     for (int l = 0; l < nl; ++l) fill_level_info(M, l);
     M->cj.n = M->lev[nl - 1].n;
     M->cj.dinv = M->lev[nl - 1].dinv;
-    return MPM_OK;
+    return single_copies(M, 0);
 }
 
 /* `sweeps` symmetric GS sweeps on u (u = 0 on entry when `from_zero`),
@@ -289,9 +332,10 @@ static void smooth(Mg *M, int l, int from_zero, int last_residual)
     const size_t len = 3 * (size_t)L->n;
     for (int s = 0; s < M->sweeps; ++s) {
         double *target = (from_zero && s == 0) ? L->u : L->d;
-        sgs_sweep(L->A, L->dinv, L->col, L->r, target, L->work);
+        if (M->single) sgs_sweep_single(L->A, L->valf, L->dinv, L->col, L->r, target, L->work);
+        else sgs_sweep(L->A, L->dinv, L->col, L->r, target, L->work);
         if (target == L->d) vec_axpy(len, 1.0, L->d, L->u);
-        if (s + 1 < M->sweeps || last_residual) bsr_spmv_sub(L->A, target, L->r);
+        if (s + 1 < M->sweeps || last_residual) level_residual(M, l, target, L->r);
     }
 }
 
@@ -359,7 +403,7 @@ static int mg_apply(InvApprox *self, const double *in, double *out)
         t0 = omp_get_wtime();
         mg_prolong(&L->T, M->lev[l + 1].u, L->d);
         vec_axpy(len, 1.0, L->d, L->u);
-        bsr_spmv_sub(L->A, L->d, L->r);
+        level_residual(M, l, L->d, L->r);
         double t1 = omp_get_wtime();
         smooth(M, l, 0, 0);
         M->info.transfer_apply_s += t1 - t0;
@@ -389,6 +433,7 @@ static void mg_destroy(InvApprox *self)
         free(L->u);
         free(L->d);
         free(L->work);
+        free(L->valf);
         gmg_level_free(&M->gl[l]);
     }
     pcg_work_free(&M->pw);
@@ -405,6 +450,7 @@ static void mg_view(const InvApprox *self, FILE *f, InvView *out)
                 info->rediscretized ? "geometric, rediscretised from particles"
                 : info->embedding == MG_EMBED_LINEAR ? "linear embedding" : "quadratic embedding",
                 info->n_levels, self->stats.setup_s, info->transfer_s, info->galerkin_s, info->diag_s);
+        if (M->single) fprintf(f, "  smoother_precision=single: single-precision copies %.4f s\n", info->single_s);
         for (int l = 0; l < info->n_levels; ++l)
             fprintf(f, "  level %d: %8d nodes %10lld blocks  blocks/row avg %6.1f max %4d  smooth %.4f s\n", l,
                     info->n[l], (long long)info->nnzb[l], info->avg_row[l], info->max_row[l], info->smooth_s[l]);

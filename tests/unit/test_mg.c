@@ -182,10 +182,11 @@ static void test_galerkin(const SynthProblem *p, MgEmbedding kind)
 }
 
 /* ---- V-cycle symmetry ---- */
-static void test_vcycle_symmetry(const SynthProblem *p, const char *embedding)
+static void test_vcycle_symmetry(const SynthProblem *p, const char *embedding, const char *precision)
 {
     SolverOptions o = {0};
     set_opt(&o, "coarse_exact", "1");
+    set_opt(&o, "smoother_precision", precision);
     set_opt(&o, "min_coarse_nodes", "50");
     set_opt(&o, "embedding", embedding);
     InvApprox *V = NULL;
@@ -209,11 +210,12 @@ static void test_vcycle_symmetry(const SynthProblem *p, const char *embedding)
         inv_apply(V, x, Vx);
         inv_apply(V, y, Vy);
         double xVy = vec_dot(len, x, Vy), yVx = vec_dot(len, y, Vx), xVx = vec_dot(len, x, Vx);
-        CHECK(rel_diff(xVy, yVx, 1e-300) < 1e-8, "mg %s exact-coarse V-cycle symmetry: %.15g vs %.15g", embedding,
+        CHECK(rel_diff(xVy, yVx, 1e-300) < 1e-8, "mg %s/%s exact-coarse V-cycle symmetry: %.15g vs %.15g", embedding, precision,
               xVy, yVx);
         CHECK(xVx > 0.0, "mg %s: x^T V x = %g", embedding, xVx);
         if (trial == 0)
-            printf("mg %s exact-coarse V-cycle: x^T V y = %.15g, y^T V x = %.15g (rel %.2g)\n", embedding, xVy, yVx,
+            printf("mg %s/%s exact-coarse V-cycle: x^T V y = %.15g, y^T V x = %.15g (rel %.2g)\n", embedding, precision,
+                   xVy, yVx,
                    rel_diff(xVy, yVx, 1e-300));
     }
     /* reproducible run to run */
@@ -354,8 +356,12 @@ int main(void)
     }
     test_galerkin(&p, MG_EMBED_LINEAR);
     test_galerkin(&p, MG_EMBED_QUADRATIC);
-    test_vcycle_symmetry(&p, "linear");
-    test_vcycle_symmetry(&p, "quadratic");
+    test_vcycle_symmetry(&p, "linear", "double");
+    test_vcycle_symmetry(&p, "quadratic", "double");
+    /* single-precision smoother values (SPEC 6.10): still a fixed symmetric
+     * positive map (the smoother and every residual read the same values) */
+    test_vcycle_symmetry(&p, "linear", "single");
+    test_vcycle_symmetry(&p, "quadratic", "single");
 
     /* options and errors */
     {
@@ -370,7 +376,8 @@ int main(void)
         CHECK(inv_create(&inv_mg_ops, &o2, &V) == MPM_EINPUT, "sweeps=x must be rejected");
         /* integer options are integers in range, never a silent cast */
         static const char *bad[][2] = {{"levels", "2.5"}, {"sweeps", "1e10"}, {"coarse_max_iters", "1.5"},
-                                       {"min_coarse_nodes", "-3"}, {"rediscretize", "2"}, {"embedding", "cubic"}};
+                                       {"min_coarse_nodes", "-3"}, {"rediscretize", "2"}, {"embedding", "cubic"},
+                                       {"smoother_precision", "half"}};
         for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
             SolverOptions ob = {0};
             set_opt(&ob, bad[k][0], bad[k][1]);
