@@ -113,6 +113,8 @@ static int ensure_stencils(Stencils *st, size_t n)
     st->w = p;
     if (!(p = realloc(st->dw, sizeof(double) * 3 * MPM_STENCIL * cap))) goto oom;
     st->dw = p;
+    if (!(p = realloc(st->f1d, sizeof(double) * 18 * cap))) goto oom;
+    st->f1d = p;
     if (!(p = realloc(st->base, sizeof(int) * 3 * cap))) goto oom;
     st->base = p;
     if (!(p = realloc(st->perm, sizeof(size_t) * cap))) goto oom;
@@ -187,6 +189,8 @@ int grid_build(Grid *g, Stencils *st, Particles *p, double dx)
     for (size_t k = 0; k < np; ++k) {
         double N[3][3], dN[3][3];
         for (int d = 0; d < 3; ++d) bspline2_1d(p->x[3 * k + d], inv_dx, N[d], dN[d]);
+        memcpy(st->f1d + 18 * k, N, sizeof N);
+        memcpy(st->f1d + 18 * k + 9, dN, sizeof dN);
         double *w = st->w + MPM_STENCIL * k, *dw = st->dw + 3 * MPM_STENCIL * k;
         for (int a = 0; a < 3; ++a)
             for (int b = 0; b < 3; ++b)
@@ -328,6 +332,7 @@ void stencils_use_mls_gradients(Stencils *st, const Particles *p, double dx)
             int b = bspline2_1d(p->x[3 * k + d], inv_dx, N[d], dN[d]);
             mls_factor_1d(p->x[3 * k + d], inv_dx, b, N[d], G[d]);
         }
+        memcpy(st->f1d + 18 * k + 9, G, sizeof G);
         double *dw = st->dw + 3 * MPM_STENCIL * k;
         for (int a = 0; a < 3; ++a)
             for (int b = 0; b < 3; ++b)
@@ -359,6 +364,7 @@ void stencils_free(Stencils *st)
     free(st->node);
     free(st->w);
     free(st->dw);
+    free(st->f1d);
     free(st->base);
     free(st->perm);
     free(st->scratch);

@@ -48,6 +48,10 @@ typedef struct {
     double *w;     /* 27 per particle */
     double *dw;    /* 81 per particle: weight gradients (27 x 3), or their MLS substitute */
     int mls;       /* 1: dw holds the MLS substitute (stencils_use_mls_gradients) */
+    double *f1d;   /* 18 per particle: w and dw as tensor products, N[d][k] (9) then D[d][k] (9),
+                    * D = dN or the MLS factor: for slot s = 9a + 3b + c, w_s = N0a N1b N2c and
+                    * dw_s = (D0a N1b N2c, N0a D1b N2c, N0a N1b D2c) (the gradient reads these
+                    * 144 bytes instead of 648) */
     NodeColoring pcolor; /* particle blocks (particles sorted by base-node block) */
     int *base;     /* 3 per particle: base node */
     size_t *perm;  /* sort scratch */

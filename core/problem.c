@@ -6,6 +6,8 @@
 
 #include "core/error.h"
 #include "core/fcr.h"
+#include "core/fcr4.h"
+#include "core/gradient_cell.h"
 #include "core/hessian_cell.h"
 #include "core/mat3.h"
 #include "core/reduce.h"
@@ -198,32 +200,61 @@ typedef struct {
     const double *dv;
 } EnergyArgs;
 
-/* Elastic energy of particles [begin, end); stores F(dv) and P(F) per particle. */
+/* dt (v_i + dv_i) of the stencil nodes, kept across the particles of a
+ * cell (they share their 27 nodes): slot s holds node id[s]'s value. */
+typedef struct {
+    int id[27];
+    double u[27][3];
+} NodeCache;
+
+/* F_p(dv) = F_p^n + dt sum_i (v_i + dv_i) a_ip^T (SPEC 3) into F, summed
+ * over the stencil in slot order (in registers: F may alias nothing). */
+static inline void gather_F(const StepProblem *pb, const double *dv, size_t k, NodeCache *nc, double *restrict Fout)
+{
+    const int *node = pb->st->node + 27 * k;
+    const double *a = pb->a + 81 * k, *vn = pb->grid->v;
+    double dt = pb->dt;
+    double F[9];
+    m3_copy(F, pb->parts->F + 9 * k);
+    for (int s = 0; s < 27; ++s) {
+        int i = node[s];
+        if (i < 0) continue;
+        double *u = nc->u[s];
+        if (nc->id[s] != i) {
+            nc->id[s] = i;
+            u[0] = dt * (vn[3 * i] + dv[3 * i]);
+            u[1] = dt * (vn[3 * i + 1] + dv[3 * i + 1]);
+            u[2] = dt * (vn[3 * i + 2] + dv[3 * i + 2]);
+        }
+        const double *as = a + 3 * s;
+        F[0] += u[0] * as[0]; F[1] += u[0] * as[1]; F[2] += u[0] * as[2];
+        F[3] += u[1] * as[0]; F[4] += u[1] * as[1]; F[5] += u[1] * as[2];
+        F[6] += u[2] * as[0]; F[7] += u[2] * as[1]; F[8] += u[2] * as[2];
+    }
+    m3_copy(Fout, F);
+}
+
+/* Elastic energy of particles [begin, end); stores F(dv) and P(F) per
+ * particle. Four particles at a time share the SIMD lanes of the SVD
+ * (core/fcr4.h); the sum keeps the particle order. */
 static double elastic_range(const void *ctx, size_t begin, size_t end)
 {
     const EnergyArgs *ea = ctx;
     StepProblem *pb = ea->pb;
-    const double *dv = ea->dv;
     const Particles *p = pb->parts;
-    const Stencils *st = pb->st;
-    const double *vn = pb->grid->v;
-    double dt = pb->dt, e = 0.0;
-    for (size_t k = begin; k < end; ++k) {
-        const int *node = st->node + 27 * k;
-        const double *a = pb->a + 81 * k;
-        double *F = pb->F + 9 * k;
-        m3_copy(F, p->F + 9 * k);
-        for (int s = 0; s < 27; ++s) {
-            int i = node[s];
-            if (i < 0) continue;
-            double u0 = dt * (vn[3 * i] + dv[3 * i]), u1 = dt * (vn[3 * i + 1] + dv[3 * i + 1]),
-                   u2 = dt * (vn[3 * i + 2] + dv[3 * i + 2]);
-            const double *as = a + 3 * s;
-            F[0] += u0 * as[0]; F[1] += u0 * as[1]; F[2] += u0 * as[2];
-            F[3] += u1 * as[0]; F[4] += u1 * as[1]; F[5] += u1 * as[2];
-            F[6] += u2 * as[0]; F[7] += u2 * as[1]; F[8] += u2 * as[2];
-        }
-        e += p->vol[k] * fcr_psi_P(F, pb->mu[k], pb->lambda[k], pb->P + 9 * k);
+    double e = 0.0;
+    NodeCache nc;
+    for (int s = 0; s < 27; ++s) nc.id[s] = -1;
+    size_t k = begin;
+    for (; k + 4 <= end; k += 4) {
+        for (int l = 0; l < 4; ++l) gather_F(pb, ea->dv, k + l, &nc, pb->F + 9 * (k + l));
+        double psi[4];
+        fcr_psi_P4(pb->F + 9 * k, pb->mu + k, pb->lambda + k, pb->P + 9 * k, psi, pb->stress_kernel);
+        for (int l = 0; l < 4; ++l) e += p->vol[k + l] * psi[l];
+    }
+    for (; k < end; ++k) {
+        gather_F(pb, ea->dv, k, &nc, pb->F + 9 * k);
+        e += p->vol[k] * fcr_psi_P(pb->F + 9 * k, pb->mu[k], pb->lambda[k], pb->P + 9 * k);
     }
     return e;
 }
@@ -265,19 +296,31 @@ void problem_gradient(StepProblem *pb, const double *dv, double *grad)
 #pragma omp parallel for schedule(dynamic, 4)
         for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
             int q = pc->color_blocks[qi];
-            for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
+            int k = pc->block_start[q], kend = pc->block_start[q + 1];
+            while (k < kend) {
+                /* the particles of one cell (same base node) share their stencil */
+                const int *b0 = st->base + 3 * (size_t)k;
+                int k1 = k + 1;
+                while (k1 < kend && memcmp(st->base + 3 * (size_t)k1, b0, 3 * sizeof(int)) == 0) ++k1;
+                /* the next cell's node ids, read only at its scatter (a
+                 * cell's particles between: no hardware stream covers them) */
+                __builtin_prefetch(st->node + 27 * (size_t)k1);
+                __builtin_prefetch(st->node + 27 * (size_t)k1 + 16);
+                _Alignas(32) double f[GRADIENT_CELL_SIZE];
+                gradient_cell(k1 - k, pb->P + 9 * (size_t)k, p->F + 9 * (size_t)k, st->f1d + 18 * (size_t)k,
+                              p->vol + k, dt, f, pb->gradient_kernel);
+                /* node ids: the first particle's; where its weight is 0, another's */
                 const int *node = st->node + 27 * (size_t)k;
-                const double *a = pb->a + 81 * (size_t)k, *P = pb->P + 9 * (size_t)k;
-                double s = dt * p->vol[k];
                 for (int t = 0; t < 27; ++t) {
                     int i = node[t];
+                    for (int kk = k + 1; i < 0 && kk < k1; ++kk) i = st->node[27 * (size_t)kk + t];
                     if (i < 0) continue;
-                    double f[3];
-                    m3_mulv(P, a + 3 * t, f);
-                    grad[3 * i] += s * f[0];
-                    grad[3 * i + 1] += s * f[1];
-                    grad[3 * i + 2] += s * f[2];
+                    const double *ft = f + 12 * (t / 3) + t % 3;
+                    grad[3 * i] += ft[0];
+                    grad[3 * i + 1] += ft[4];
+                    grad[3 * i + 2] += ft[8];
                 }
+                k = k1;
             }
         }
     }

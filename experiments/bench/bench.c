@@ -6,6 +6,8 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/fcr4.h"
+#include "core/gradient_cell.h"
 #include "core/hessian_cell.h"
 #include "core/step.h"
 #include "core/transfer.h"
@@ -18,6 +20,7 @@ typedef struct {
     Bsr *H;
     double *x, *y;
     double *vnew;
+    double *dv, *grad; /* the line search's point and its gradient */
     ExplicitForce force;
     G2POptions g2p;
 } BenchCtx;
@@ -39,6 +42,20 @@ static void run_assemble(void *ctx)
     BenchCtx *b = ctx;
     problem_tangent(&b->sim->pb, 1);
     problem_assemble(&b->sim->pb, b->H);
+}
+
+/* One line-search trial: F(dv), SVD, psi and P per particle (SPEC 3). */
+static void run_energy(void *ctx)
+{
+    BenchCtx *b = ctx;
+    problem_energy(&b->sim->pb, b->dv);
+}
+
+/* The accepted point's gradient: the scatter of the cached P. */
+static void run_gradient(void *ctx)
+{
+    BenchCtx *b = ctx;
+    problem_gradient(&b->sim->pb, b->dv, b->grad);
 }
 
 static void run_scatter(void *ctx)
@@ -126,6 +143,40 @@ static KernelModel model_assemble(double blocks_per_particle)
     return m;
 }
 
+/* Energy (problem_energy at one dv), counted from core/problem.c, svd3.c, fcr.c:
+ *  gather F = F^n + dt sum_i (v_i + dv_i) a_ip^T: 27 x (6 for u_i, 18 for u a^T) = 648;
+ *  svd3: scaling 18; a Jacobi pair test 18 flops, a rotation 51 more (sqrt and
+ *  divides counted as one flop each); after the sweeps (norms, sort, U, signs) 55;
+ *  fixed-corotated psi and P: J 2, R = U V^T 45, cof F 27, P 39, psi 14 = 127;
+ *  V_p psi 2; inertia 15 per node. The sweeps depend on F: pair tests and
+ *  rotations per particle are measured on bar3's first step (about 11.5 tests,
+ *  7.56 rotations, 3.8 sweeps), so the count is for that state.
+ * Bytes: a_ip 648, F^n 72, node ids 108, vol, mu, lambda 24, F and P written 144;
+ *  v^n, dv 48 per node. */
+#define ENERGY_SVD_TESTS 11.5
+#define ENERGY_SVD_ROTATIONS 7.56
+static KernelModel model_energy(double nodes_per_particle, double tests, double rotations)
+{
+    KernelModel m = {"energy (F, SVD, psi, P)", 0, 0};
+    m.flops = 648.0 + 18.0 + 18.0 * tests + 51.0 * rotations + 55.0 + 127.0 + 2.0 + 15.0 * nodes_per_particle;
+    m.bytes = 648.0 + 72.0 + 108.0 + 24.0 + 144.0 + 48.0 * nodes_per_particle;
+    return m;
+}
+
+/* Gradient at the cached P, by cells (core/gradient_cell.c): per particle
+ * Q = dt V_p P F^nT (54); per node grad w_ip from its tensor factors (4),
+ * Q grad w (15) and the cell sum (3) -> 27 x 22; per cell the scatter (3 a
+ * node, 81 over the cell's particles); inertia and gravity 9 per node.
+ * Bytes: P, F^n 144, the factors of w 144, vol and base 20, node ids 108 a
+ * cell; dv and mass read, the gradient written (56 per node). */
+static KernelModel model_gradient(double nodes_per_particle, double particles_per_cell)
+{
+    KernelModel m = {"gradient (scatter of P)", 0, 0};
+    m.flops = 54.0 + 27.0 * 22.0 + 81.0 / particles_per_cell + 9.0 * nodes_per_particle;
+    m.bytes = 144.0 + 144.0 + 20.0 + 108.0 / particles_per_cell + 56.0 * nodes_per_particle;
+    return m;
+}
+
 typedef struct {
     double stream_gbs, peak_machine, peak_build;
     size_t np;
@@ -162,18 +213,17 @@ int bench_run(const char *what, const RunConfig *cfg)
     StepProblem *pb = &sim.pb;
     int n = pb->n_nodes;
     size_t np = sim.p.n;
-    double *dv = malloc(sizeof(double) * 3 * (size_t)n);
+    double *dv = bc.dv = malloc(sizeof(double) * 3 * (size_t)n);
+    bc.grad = malloc(sizeof(double) * 3 * (size_t)n);
     bc.x = malloc(sizeof(double) * 3 * (size_t)n);
     bc.y = malloc(sizeof(double) * 3 * (size_t)n);
     bc.vnew = malloc(sizeof(double) * 3 * (size_t)n);
-    if (!dv || !bc.x || !bc.y || !bc.vnew) {
-        free(dv);
+    if (!dv || !bc.grad || !bc.x || !bc.y || !bc.vnew) {
         status = mpm_error(MPM_EINTERNAL, "out of memory in bench");
         goto done;
     }
     problem_initial_guess(pb, dv);
     problem_energy(pb, dv);
-    free(dv);
     problem_tangent(pb, 1);
     if ((status = problem_assemble(pb, &H))) goto done;
     for (int i = 0; i < 3 * n; ++i) bc.x[i] = 1.0 + 1e-3 * (i % 17);
@@ -236,6 +286,25 @@ int bench_run(const char *what, const RunConfig *cfg)
         printf("%-28s %10.3f ms %10.3g p/s\nscatter_particles_per_s=%.4g\n", "assemble (scatter only)", 1e3 * t2,
                np / t2, np / t2);
     }
+    if (all || !strcmp(what, "energy")) {
+        /* a trial point off the initial guess, as a line search's: dv0 + 1e-3 x */
+        for (int i = 0; i < 3 * n; ++i) bc.y[i] = 1e-3 * bc.x[i];
+        problem_project(pb, bc.y);
+        for (int i = 0; i < 3 * n; ++i) bc.dv[i] += bc.y[i];
+        double t = machine_best_time(run_energy, &bc, min_s, &spread);
+        report(&L, model_energy(npp, ENERGY_SVD_TESTS, ENERGY_SVD_ROTATIONS), t, spread, "energy");
+        printf("energy_kernel_isa=%s\n", fcr4_isa());
+    }
+    if (all || !strcmp(what, "gradient")) {
+        problem_energy(pb, bc.dv); /* the cache at dv */
+        double t = machine_best_time(run_gradient, &bc, min_s, &spread);
+        size_t cells = np > 0; /* runs of one base node */
+        for (size_t k = 1; k < np; ++k)
+            cells += memcmp(sim.st.base + 3 * k, sim.st.base + 3 * (k - 1), 3 * sizeof(int)) != 0;
+        report(&L, model_gradient(npp, cells ? (double)np / (double)cells : 1.0), t, spread, "gradient");
+        printf("gradient_kernel_isa=%s\ngradient_particles_per_cell=%.2f\n", gradient_cell_isa(),
+               cells ? (double)np / (double)cells : 0.0);
+    }
     if (all || !strcmp(what, "p2g")) {
         double t = machine_best_time(run_p2g, &bc, min_s, &spread);
         report(&L, model_p2g(scene.transfer == TRANSFER_MLS, npp), t, spread, "p2g");
@@ -253,6 +322,8 @@ int bench_run(const char *what, const RunConfig *cfg)
     printf("transfer=%s\nstream_dram_gbs=%.3f\npeak_gflops=%.3f\npeak_isa=%s\nbuild_peak_gflops=%.3f\nthreads=%d\n",
            tname, L.stream_gbs, L.peak_machine, peak.isa, L.peak_build, threads);
 done:
+    free(bc.dv);
+    free(bc.grad);
     free(bc.x);
     free(bc.y);
     free(bc.vnew);

@@ -5,6 +5,8 @@
  *             triad over the same working-set size, and H x for comparison;
  *   hessvec   matrix-free H x;
  *   assemble  projected dP/dF and the block-CSR assembly (and scatter only);
+ *   energy    one line-search trial: F(dv), SVD, psi and P per particle;
+ *   gradient  the gradient at that point (the scatter of the cached P);
  *   p2g, g2p  the MLS-MPM supplement's transfer kernels (section 3: P2G with
  *             the force from F, linear elasticity, and the normalisation;
  *             G2P with the F update and advection), APIC or MLS by the

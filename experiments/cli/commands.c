@@ -76,7 +76,7 @@ static const Command run_command = {
 
 /* ------------------------------------------------------------------ bench */
 
-static const char *const bench_what[] = {"spmv", "assemble", "hessvec", "p2g", "g2p", "all", NULL};
+static const char *const bench_what[] = {"spmv", "assemble", "hessvec", "energy", "gradient", "p2g", "g2p", "all", NULL};
 static const char *const bench_transfers[] = {"apic", "mls", NULL};
 
 typedef struct {
@@ -116,7 +116,7 @@ static int bench_cmd(void *args, const char *what, int *exit_code)
 
 static const Command bench_command = {
     .name = "bench",
-    .operand = "spmv|assemble|hessvec|p2g|g2p|all",
+    .operand = "spmv|assemble|hessvec|energy|gradient|p2g|g2p|all",
     .operand_choices = bench_what,
     .operand_missing = "spmv, assemble, hessvec, p2g, g2p or all",
     .required = bench_required,
