@@ -68,19 +68,23 @@ static const SolverPreset g_presets[] = {
      * results/ml-tuning; docs/solvers.md "Setup reuse") */
     {"pn-mgpcg", "projected Newton, PCG preconditioned by one node-embedding Galerkin V-cycle, its coarse levels "
      "kept for the step (HOT PN-MGPCG with setup reuse; reuse_every=1 rebuilds every iteration as HOT does)",
-     "pn", "mg", "reuse_every=0,reuse_refresh=0"},
+     "pn", "mg", "reuse_every=0,reuse_refresh=0,smoother_precision=single"},
     {"pn-amg-pcg", "projected Newton, PCG preconditioned by one hypre BoomerAMG V-cycle, tuned, kept for the step "
      "(algebraic baseline)", "pn", "boomeramg", "amg_strong_threshold=0.25,reuse_every=0"},
     {"pn-ml-pcg", "projected Newton, PCG preconditioned by one Trilinos ML aggregation V-cycle, tuned, kept for the "
      "step (algebraic baseline)", "pn", "ml", "ml_damping=0,reuse_every=0"},
     {"pn-cholmod", "projected Newton with exact CHOLMOD Cholesky solves (exact-Newton reference)", "pn", "cholmod", ""},
+    /* the multigrid presets smooth on single-precision copies of their
+     * levels' matrices: the same iterations in less time on every scene
+     * measured (results/smoother-precision; SPEC 6.10) */
     {"hot", "L-BFGS, initial inverse = one linear-embedding Galerkin multigrid V-cycle built once per step (HOT)",
-     "lbfgs", "mg", ""},
-    {"hot-quadratic", "HOT with the quadratic embedding kernel", "lbfgs", "mg", "embedding=quadratic"},
+     "lbfgs", "mg", "smoother_precision=single"},
+    {"hot-quadratic", "HOT with the quadratic embedding kernel", "lbfgs", "mg",
+     "embedding=quadratic,smoother_precision=single"},
     {"lbfgs-gmg", "L-BFGS, initial inverse = one V-cycle of particle-rediscretised geometric multigrid (HOT LBFGS-GMG)",
-     "lbfgs", "mg", "rediscretize=1"},
+     "lbfgs", "mg", "rediscretize=1,smoother_precision=single"},
     {"pn-gmgpcg", "projected Newton, PCG preconditioned by the particle-rediscretised geometric multigrid V-cycle", "pn",
-     "mg", "rediscretize=1"},
+     "mg", "rediscretize=1,smoother_precision=single"},
     {"lbfgs-h", "L-BFGS, initial inverse = inexact block-Jacobi PCG on the start-of-step Hessian (HOT LBFGS-H)",
      "lbfgs", "inexact-pcg", ""},
     {"lbfgs-h-direct", "L-BFGS, initial inverse = CHOLMOD factor of the start-of-step Hessian (Li et al. 2019)", "lbfgs",
