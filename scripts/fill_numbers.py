@@ -341,6 +341,22 @@ def paper_particles():
     return f"{grouped(min(parts))} to {grouped(max(parts))}"
 
 
+def smoother_ratio(solver, what="geo"):
+    """smoother-precision: mean s/frame of the single runs over that of the
+    double runs per scene (quiet machine), geometric mean or range."""
+    by = {}
+    for r in table("smoother-precision", "cells.csv"):
+        if r["solver"] == solver and r.get("machine_busy", "0") != "1" and r["status"] == "ok":
+            by.setdefault((r["scene"], r["precision"]), []).append(num(r, "s_per_frame"))
+    mean = lambda v: sum(v) / len(v)
+    ratios = [mean(by[(sc, "single")]) / mean(v) for (sc, p), v in by.items() if p == "double" and (sc, "single") in by]
+    if not ratios:
+        raise Missing(f"results/smoother-precision has no pair of {solver} cells")
+    if what == "range":
+        return span(ratios, 2)
+    return f"{math.exp(sum(math.log(x) for x in ratios) / len(ratios)):.2f}"
+
+
 def table1_ratio(scene, slow, fast):
     a = num(one("gast15-table1", scene=scene, solver=slow), "s_per_frame")
     b = num(one("gast15-table1", scene=scene, solver=fast), "s_per_frame")
@@ -449,6 +465,12 @@ NUMBERS = {
     "paper.hot_geomean": lambda: geomean("paper-scale", "hot"),
     "paper.hot_range": lambda: speedup_range("paper-scale", "hot"),
     "paper.mf_geomean": lambda: geomean("paper-scale", "pn-pcg-mf"),
+    "sp.cells": lambda: cells_ok("smoother-precision"),
+    "sp.date": lambda: run_date("smoother-precision"),
+    "sp.hot": lambda: smoother_ratio("hot"),
+    "sp.hot_range": lambda: smoother_ratio("hot", "range"),
+    "sp.mgpcg": lambda: smoother_ratio("pn-mgpcg"),
+    "sp.gmg": lambda: smoother_ratio("lbfgs-gmg"),
     "fig18.cells": lambda: cells_ok("gast15-fig18"),
     "fig18.date": lambda: run_date("gast15-fig18"),
     "fig18.gast15_vs_semi_drop": lambda: fig18_speedup("snowball-drop"),
