@@ -102,6 +102,8 @@ int grid_lookup(const Grid *g, const int c[3])
     return g->block_first[b] + __builtin_popcountll(mask & ((1ull << l) - 1));
 }
 
+int grid_block(const Grid *g, const int B[3]) { return block_find(g, pack_block(B[0], B[1], B[2])); }
+
 static int ensure_stencils(Stencils *st, size_t n)
 {
     if (n <= st->cap) return MPM_OK;

@@ -74,6 +74,12 @@ void stencils_use_mls_gradients(Stencils *st, const Particles *p, double dx);
 
 /* Node id at integer coordinates, or -1 if not active. */
 int grid_lookup(const Grid *g, const int c[3]);
+/* Index of the 4x4x4 node block at block coordinates B (node coordinates
+ * 4 B .. 4 B + 3), or -1 if it has no active node. Its node with local
+ * index l = (x & 3) << 4 | (y & 3) << 2 | (z & 3) is active when bit l of
+ * block_mask is set, and its id is block_first + the set bits below l:
+ * ids increase with the block's block_first, then with l. */
+int grid_block(const Grid *g, const int B[3]);
 
 void grid_free(Grid *g);
 void stencils_free(Stencils *st);

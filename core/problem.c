@@ -370,6 +370,8 @@ static void full_stencil_masks(uint64_t full[27][2])
     }
 }
 
+static inline int floor4(int v) { return v >= 0 ? v / 4 : -((3 - v) / 4); }
+
 static int build_pattern(StepProblem *pb, Bsr *H)
 {
     const Stencils *st = pb->st;
@@ -428,31 +430,61 @@ static int build_pattern(StepProblem *pb, Bsr *H)
                             __builtin_popcountll(pb->rowmask[2 * i + 1]);
     if ((status = bsr_reserve(H, n, H->row_ptr[n]))) return status;
     H->nnzb = H->row_ptr[n];
-    /* columns sorted by node id; slot table maps offsets to row positions */
+    /* columns sorted by node id; slot table maps offsets to row positions.
+     * Row i's neighbours (offsets -2..2 per axis) lie in at most 2x2x2 node
+     * blocks: find those once, visit them by increasing block_first and
+     * their window's nodes by increasing local index, which is increasing
+     * node id (grid.h), so no per-neighbour hash lookup and no sort. */
 #pragma omp parallel for schedule(dynamic, 64)
     for (int i = 0; i < n; ++i) {
-        int cols[NEIGH], offs[NEIGH], m = 0;
         const int *ci = g->coord + 3 * (size_t)i;
+        const uint64_t *rm = pb->rowmask + 2 * (size_t)i;
         short *slot = pb->slot + NEIGH * (size_t)i;
-        for (int o = 0; o < NEIGH; ++o) {
-            slot[o] = -1;
-            if (!((pb->rowmask[2 * (size_t)i + (o >> 6)] >> (o & 63)) & 1u)) continue;
-            int cj[3] = {ci[0] + o / 25 - 2, ci[1] + (o / 5) % 5 - 2, ci[2] + o % 5 - 2};
-            int j = grid_lookup(g, cj);
-            /* insertion sort by column id */
-            int pos = m++;
-            while (pos > 0 && cols[pos - 1] > j) {
-                cols[pos] = cols[pos - 1];
-                offs[pos] = offs[pos - 1];
-                --pos;
-            }
-            cols[pos] = j;
-            offs[pos] = o;
+        for (int o = 0; o < NEIGH; ++o) slot[o] = -1;
+        int lo[3], nb[3];
+        for (int d = 0; d < 3; ++d) {
+            lo[d] = floor4(ci[d] - 2);
+            nb[d] = floor4(ci[d] + 2) - lo[d] + 1;
         }
+        int blk[8], nblk = 0, B[8][3];
+        for (int x = 0; x < nb[0]; ++x)
+            for (int y = 0; y < nb[1]; ++y)
+                for (int z = 0; z < nb[2]; ++z) {
+                    int c[3] = {lo[0] + x, lo[1] + y, lo[2] + z}, b = grid_block(g, c);
+                    if (b < 0) continue;
+                    /* insertion by block_first (at most 8) */
+                    int pos = nblk++;
+                    while (pos > 0 && g->block_first[blk[pos - 1]] > g->block_first[b]) {
+                        blk[pos] = blk[pos - 1];
+                        memcpy(B[pos], B[pos - 1], sizeof B[pos]);
+                        --pos;
+                    }
+                    blk[pos] = b;
+                    memcpy(B[pos], c, sizeof c);
+                }
         int64_t r0 = H->row_ptr[i];
-        for (int k = 0; k < m; ++k) {
-            H->col[r0 + k] = cols[k];
-            slot[offs[k]] = (short)k;
+        int m = 0;
+        for (int q = 0; q < nblk; ++q) {
+            const uint64_t mask = g->block_mask[blk[q]];
+            const int first = g->block_first[blk[q]];
+            int a0[3], a1[3]; /* the window's local coordinates in this block */
+            for (int d = 0; d < 3; ++d) {
+                a0[d] = ci[d] - 2 - 4 * B[q][d];
+                a1[d] = ci[d] + 2 - 4 * B[q][d];
+                if (a0[d] < 0) a0[d] = 0;
+                if (a1[d] > 3) a1[d] = 3;
+            }
+            for (int x = a0[0]; x <= a1[0]; ++x)
+                for (int y = a0[1]; y <= a1[1]; ++y)
+                    for (int z = a0[2]; z <= a1[2]; ++z) {
+                        int l = x << 4 | y << 2 | z;
+                        if (!((mask >> l) & 1u)) continue;
+                        int o = 25 * (4 * B[q][0] + x - ci[0] + 2) + 5 * (4 * B[q][1] + y - ci[1] + 2) +
+                                (4 * B[q][2] + z - ci[2] + 2);
+                        if (!((rm[o >> 6] >> (o & 63)) & 1u)) continue;
+                        H->col[r0 + m] = first + __builtin_popcountll(mask & ((1ull << l) - 1));
+                        slot[o] = (short)m++;
+                    }
         }
     }
     bsr_update_pattern_id(H);
