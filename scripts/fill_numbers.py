@@ -357,6 +357,13 @@ def smoother_ratio(solver, what="geo"):
     return f"{math.exp(sum(math.log(x) for x in ratios) / len(ratios)):.2f}"
 
 
+def hot_step_ratio():
+    """results/hot-step: median s/frame of the old build over the new one."""
+    rows = table("hot-step", "bar3-scale1.csv")
+    med = lambda b: statistics.median(num(r, "frame_s") for r in rows if r["build"] == b)
+    return f"{med('old') / med('new'):.2f}"
+
+
 def table1_ratio(scene, slow, fast):
     a = num(one("gast15-table1", scene=scene, solver=slow), "s_per_frame")
     b = num(one("gast15-table1", scene=scene, solver=fast), "s_per_frame")
@@ -471,6 +478,7 @@ NUMBERS = {
     "sp.hot_range": lambda: smoother_ratio("hot", "range"),
     "sp.mgpcg": lambda: smoother_ratio("pn-mgpcg"),
     "sp.gmg": lambda: smoother_ratio("lbfgs-gmg"),
+    "hotstep.vs_27d85c7": hot_step_ratio,
     "fig18.cells": lambda: cells_ok("gast15-fig18"),
     "fig18.date": lambda: run_date("gast15-fig18"),
     "fig18.gast15_vs_semi_drop": lambda: fig18_speedup("snowball-drop"),
