@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 
 #include "core/error.h"
+#include "experiments/run/csv_write.h"
 #include "experiments/run/run.h"
 
 const char *const run_accuracy_step_header = "err_h,e_gap,err_v_max,ref_solver,ref_status,ref_s";
@@ -113,7 +114,8 @@ void run_accuracy_step_fields(FILE *f, const RunAccuracy *a)
     field(f, "%.9e", e->err_h);
     field(f, "%.9e", e->e_gap);
     field(f, "%.9e", e->err_v_max);
-    fprintf(f, "%s,%s,%.6f,", e->ref_solver, solve_status_name(e->ref_status), e->ref_s);
+    csv_write_name(f, e->ref_solver);
+    fprintf(f, ",%s,%.6f,", solve_status_name(e->ref_status), e->ref_s);
 }
 
 int run_accuracy_frame_end(RunAccuracy *a, const Simulation *sim, int frame, int steps, int complete, FILE *f)

@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/step.h"
 #include "core/scene/scene_load.h"
+#include "experiments/run/csv_write.h"
 #include "experiments/run/frame_driver.h"
 #include "experiments/run/library_startup.h"
 #include "experiments/run/paths.h"
@@ -123,17 +124,6 @@ static FILE *open_in(const char *dir, const char *name, int *status)
     return f;
 }
 
-/* A CSV field: quoted, inner quotes doubled, line breaks as spaces (RFC 4180). */
-static void csv_text(FILE *f, const char *s)
-{
-    fputc('"', f);
-    for (; *s; ++s) {
-        if (*s == '"') fputc('"', f);
-        fputc(*s == '\n' || *s == '\r' ? ' ' : *s, f);
-    }
-    fputc('"', f);
-}
-
 /* What `run` writes as the frame driver goes: the CSV rows, the table, the
  * particles. */
 typedef struct {
@@ -165,14 +155,17 @@ static int write_step(void *ctx, const Simulation *sim, int frame, int step, con
     RunOutput *o = ctx;
     FILE *f = o->steps_csv;
     /* t and dt read back as the same doubles (--dt-from replays them) */
-    fprintf(f, "%s,%s,%d,%d,%.17g,%.17g,%zu,%d,%lld,%d,%ld,%d,%.6e,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%ld,",
-            o->scene->name, o->solver->name, frame, step, si->t, si->dt, sim->p.n, si->active_nodes,
+    csv_write_name(f, o->scene->name);
+    fputc(',', f);
+    csv_write_name(f, o->solver->name);
+    fprintf(f, ",%d,%d,%.17g,%.17g,%zu,%d,%lld,%d,%ld,%d,%.6e,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%ld,",
+            frame, step, si->t, si->dt, sim->p.n, si->active_nodes,
             (long long)ss->hessian_blocks, ss->outer_iters, ss->linear_iters, ss->ls_evals, ss->residual,
             solve_status_name(ss->status), si->wall_s, si->begin_s, ss->assemble_s, ss->setup_s, ss->solve_s,
             ss->linesearch_s, si->end_s, o->threads, ss->inner_iters);
     fprintf(f, "%.9g,", ss->energy_increase_max);
     run_accuracy_step_fields(f, o->acc);
-    csv_text(f, ss->reason); /* the reason stays the last field */
+    csv_write_text(f, ss->reason); /* the reason stays the last field */
     fputc('\n', f);
     return MPM_OK;
 }
@@ -182,11 +175,14 @@ static int write_frame(void *ctx, const Simulation *sim, const FrameSums *fs, in
     RunOutput *o = ctx;
     FILE *f = o->frames_csv;
     /* complete 0: the run's time limit cut the frame short (not a frame to time) */
-    fprintf(f, "%s,%s,%d,%d,%ld,%ld,%.6f,%.6e,%s,%d,%ld,%d,", o->scene->name, o->solver->name, fs->frame, fs->steps,
+    csv_write_name(f, o->scene->name);
+    fputc(',', f);
+    csv_write_name(f, o->solver->name);
+    fprintf(f, ",%d,%d,%ld,%ld,%.6f,%.6e,%s,%d,%ld,%d,", fs->frame, fs->steps,
             fs->outer_iters, fs->linear_iters, fs->wall_s, fs->max_residual, solve_status_name((SolveStatus)fs->status),
             o->threads, fs->inner_iters, fs->completed);
     int status = run_accuracy_frame_end(o->acc, sim, fs->frame, fs->steps, fs->completed, f);
-    csv_text(f, fs->reason);
+    csv_write_text(f, fs->reason);
     fputc('\n', f);
     if (status) return status;
     fflush(o->steps_csv);
