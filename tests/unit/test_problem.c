@@ -120,6 +120,30 @@ static void mark_some_dirichlet(StepProblem *pb)
     problem_finish_dirichlet(pb);
 }
 
+/* Energy and projected tangent at a random dv, then the assembled Hessian. */
+static int assemble_at_random_dv(Fixture *f, unsigned long long seed, double *dv, double *x, Bsr *H)
+{
+    int n = f->pb.n_nodes;
+    random_vec(n, dv, &seed, 0.05);
+    random_vec(n, x, &seed, 1.0);
+    problem_energy(&f->pb, dv);
+    problem_tangent(&f->pb, 1);
+    return problem_assemble(&f->pb, H);
+}
+
+/* ||H x - (H x)_matrix-free|| / ||H x||, the products left in y1, y2. */
+static double assembled_vs_matrix_free(Fixture *f, const Bsr *H, const double *x, double *y1, double *y2)
+{
+    bsr_spmv(H, x, y1);
+    problem_hessvec(&f->pb, x, y2);
+    double err = 0, nrm = 0;
+    for (size_t i = 0; i < 3 * (size_t)f->pb.n_nodes; ++i) {
+        err += (y1[i] - y2[i]) * (y1[i] - y2[i]);
+        nrm += y1[i] * y1[i];
+    }
+    return sqrt(err / nrm);
+}
+
 static void test_assembled_equals_matrix_free(int with_bc, int mls)
 {
     FixtureOptions o;
@@ -133,24 +157,11 @@ static void test_assembled_equals_matrix_free(int with_bc, int mls)
     CHECK(fixture_build(&f, &o) == 0, "fixture");
     if (with_bc) mark_some_dirichlet(&f.pb);
     int n = f.pb.n_nodes;
-    size_t len = 3 * (size_t)n;
-    unsigned long long rs = 5;
     double *dv = alloc3(n), *x = alloc3(n), *y1 = alloc3(n), *y2 = alloc3(n);
-    random_vec(n, dv, &rs, 0.05);
-    random_vec(n, x, &rs, 1.0);
-    problem_energy(&f.pb, dv);
-    problem_tangent(&f.pb, 1);
     Bsr H = {0};
-    CHECK(problem_assemble(&f.pb, &H) == 0, "assemble");
-    bsr_spmv(&H, x, y1);
-    problem_hessvec(&f.pb, x, y2);
-    double err = 0, nrm = 0;
-    for (size_t i = 0; i < len; ++i) {
-        err += (y1[i] - y2[i]) * (y1[i] - y2[i]);
-        nrm += y1[i] * y1[i];
-    }
-    CHECK(sqrt(err / nrm) < 1e-14, "assembled vs matrix-free (bc=%d, mls=%d): rel diff %.3e", with_bc, mls,
-          sqrt(err / nrm));
+    CHECK(assemble_at_random_dv(&f, 5, dv, x, &H) == 0, "assemble");
+    double rel = assembled_vs_matrix_free(&f, &H, x, y1, y2);
+    CHECK(rel < 1e-14, "assembled vs matrix-free (bc=%d, mls=%d): rel diff %.3e", with_bc, mls, rel);
     /* diagonal blocks agree too */
     double *D1 = calloc(9 * (size_t)n, sizeof(double)), *D2 = calloc(9 * (size_t)n, sizeof(double));
     bsr_diagonal(&H, D1);
@@ -317,26 +328,15 @@ static void test_pattern_cell_union(void)
     CHECK(missing_nodes > 0 && only_union > 0, "the fixture exercises zero weights (%d missing stencil nodes) and pairs "
           "of a cell no particle touches (%zu)", missing_nodes, only_union);
     double *dv = alloc3(n), *x = alloc3(n), *y1 = alloc3(n), *y2 = alloc3(n);
-    unsigned long long rs = 9;
-    random_vec(n, dv, &rs, 0.05);
-    random_vec(n, x, &rs, 1.0);
-    problem_energy(&f.pb, dv);
-    problem_tangent(&f.pb, 1);
     Bsr H = {0};
-    CHECK(problem_assemble(&f.pb, &H) == 0, "assemble");
+    CHECK(assemble_at_random_dv(&f, 9, dv, x, &H) == 0, "assemble");
     size_t wrong = 0;
     for (int i = 0; i < H.n; ++i)
         for (int64_t k = H.row_ptr[i]; k < H.row_ptr[i + 1]; ++k) wrong += !ref[(size_t)i * n + H.col[k]];
     CHECK(wrong == 0 && (size_t)H.nnzb == nref, "pattern = the cells' node-union pairs: %lld blocks, %zu expected, %zu "
           "not expected", (long long)H.nnzb, nref, wrong);
-    bsr_spmv(&H, x, y1);
-    problem_hessvec(&f.pb, x, y2);
-    double err = 0, nrm = 0;
-    for (size_t i = 0; i < 3 * (size_t)n; ++i) {
-        err += (y1[i] - y2[i]) * (y1[i] - y2[i]);
-        nrm += y1[i] * y1[i];
-    }
-    CHECK(sqrt(err / nrm) < 1e-14, "zero weights: assembled vs matrix-free rel diff %.3e", sqrt(err / nrm));
+    double rel = assembled_vs_matrix_free(&f, &H, x, y1, y2);
+    CHECK(rel < 1e-14, "zero weights: assembled vs matrix-free rel diff %.3e", rel);
     bsr_free(&H);
     free(ref), free(single), free(dv), free(x), free(y1), free(y2);
     fixture_free(&f);
