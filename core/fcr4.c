@@ -9,6 +9,7 @@
 #include <math.h>
 
 #include "core/fcr.h"
+#include "core/svd3.h"
 
 static void fcr4_portable(const double *F, const double *mu, const double *lambda, double *P, double psi[4])
 {
@@ -34,9 +35,6 @@ typedef __m256d V;
 #define AVX __attribute__((target("avx")))
 #define AVXI static inline __attribute__((target("avx"), always_inline))
 
-/* svd3.c's constants */
-enum { MAX_SWEEPS = 16 };
-static const double TOL = 2.0 * DBL_EPSILON, TINY2 = 1e-280;
 
 AVXI V add(V a, V b) { return _mm256_add_pd(a, b); }
 AVXI V sub(V a, V b) { return _mm256_sub_pd(a, b); }
@@ -56,7 +54,7 @@ AVXI V dot3(const V x[3], const V y[3]) { return add(add(mul(x[0], y[0]), mul(x[
 AVXI int jacobi4(V ci[3], V cj[3], V vi[3], V vj[3])
 {
     V a = dot3(ci, ci), b = dot3(cj, cj), g = dot3(ci, cj);
-    V rot = _mm256_cmp_pd(mul(g, g), mul(cst(TOL * TOL), mul(a, b)), _CMP_GT_OQ);
+    V rot = _mm256_cmp_pd(mul(g, g), mul(cst(SVD3_TOL * SVD3_TOL), mul(a, b)), _CMP_GT_OQ);
     int bits = _mm256_movemask_pd(rot);
     if (!bits) return 0;
     V d = sub(b, a), ad = vabs(d);
@@ -103,7 +101,7 @@ AVX static int fcr4_avx(const double *F, const double *mu, const double *lambda,
             c[k][r] = f[3 * r + k];
             v[k][r] = cst(k == r ? 1.0 : 0.0);
         }
-    for (int sweep = 0; sweep < MAX_SWEEPS; ++sweep) {
+    for (int sweep = 0; sweep < SVD3_MAX_SWEEPS; ++sweep) {
         int rot = jacobi4(c[0], c[1], v[0], v[1]);
         rot |= jacobi4(c[0], c[2], v[0], v[2]);
         rot |= jacobi4(c[1], c[2], v[1], v[2]);
@@ -122,7 +120,7 @@ AVX static int fcr4_avx(const double *F, const double *mu, const double *lambda,
     V w[3];
     for (int k = 0; k < 3; ++k) w[k] = sub(c[1][k], mul(d, u[0][k]));
     V wn2 = dot3(w, w);
-    int rank1 = _mm256_movemask_pd(_mm256_cmp_pd(wn2, cst(TINY2), _CMP_NGT_UQ)); /* !(wn2 > TINY2) */
+    int rank1 = _mm256_movemask_pd(_mm256_cmp_pd(wn2, cst(SVD3_TINY2), _CMP_NGT_UQ)); /* !(wn2 > SVD3_TINY2) */
     V wn = sqr(wn2);
     for (int k = 0; k < 3; ++k) u[1][k] = dvd(w[k], wn);
     u[2][0] = sub(mul(u[0][1], u[1][2]), mul(u[0][2], u[1][1]));

@@ -23,15 +23,6 @@
 #include <math.h>
 #include <string.h>
 
-enum { SVD3_MAX_SWEEPS = 16 };
-
-/* Pairs are treated as orthogonal when |ci.cj| <= tol |ci| |cj|. */
-static const double SVD3_TOL = 2.0 * DBL_EPSILON;
-
-/* Below this squared norm (relative to a largest column of norm ~1 after
- * scaling) a column carries no usable direction. */
-static const double SVD3_TINY2 = 1e-280;
-
 /* Rotates columns ci, cj (and vi, vj of V) so that ci . cj = 0.
  * Returns 1 if a rotation was applied. */
 static inline int jacobi_pair(double ci[3], double cj[3], double vi[3], double vj[3])
