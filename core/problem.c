@@ -45,7 +45,6 @@ static int ensure_capacity(StepProblem *pb, size_t np, int nn)
         st |= grow((void **)&pb->stiff, sizeof(double) * c);
         st |= grow((void **)&pb->F, sizeof(double) * 9 * c);
         st |= grow((void **)&pb->P, sizeof(double) * 9 * c);
-        st |= grow((void **)&pb->A, sizeof(double) * 81 * c);
         if (st) return MPM_EINTERNAL;
         pb->cap_particles = c;
     }
@@ -80,6 +79,7 @@ int problem_prepare(StepProblem *pb, const Grid *g, const Stencils *st, const Pa
     pb->mats = mats;
     pb->n_mats = n_mats;
     pb->pattern_ready = 0;
+    pb->tangent_stored = 0;
     pb->n_dirichlet = 0;
 
     double maxstiff = 0.0;
@@ -279,6 +279,7 @@ static double inertial_range(const void *ctx, size_t begin, size_t end)
 double problem_energy(StepProblem *pb, const double *dv)
 {
     EnergyArgs ea = {pb, dv};
+    pb->tangent_stored = 0; /* F changes */
     double elastic = reduce_sum(pb->parts->n, 64, elastic_range, &ea);
     pb->elastic_energy = elastic;
     double inertial = reduce_sum((size_t)pb->n_nodes, 1024, inertial_range, &ea);
@@ -330,13 +331,34 @@ void problem_gradient(StepProblem *pb, const double *dv, double *grad)
     problem_project(pb, grad);
 }
 
+double *problem_tangent_storage(StepProblem *pb)
+{
+    size_t n = pb->parts->n;
+    if (n > pb->cap_A) {
+        size_t c = n + n / 4 + 256;
+        if (grow((void **)&pb->A, sizeof(double) * 81 * c)) return NULL;
+        pb->cap_A = c;
+    }
+    return pb->A;
+}
+
 int problem_tangent(StepProblem *pb, int projected)
 {
     const Particles *p = pb->parts;
+    if (!problem_tangent_storage(pb)) return MPM_EINTERNAL;
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < p->n; ++k) fcr_dPdF(pb->F + 9 * k, pb->mu[k], pb->lambda[k], projected, pb->A + 81 * k);
     pb->tangent_projected = projected;
+    pb->tangent_stored = 1;
     return MPM_OK;
+}
+
+/* hessvec and diagonal after a fused assembly (or none): the tangent is
+ * computed here; if that fails, y is NaN so the solve stops as a
+ * numerical breakdown instead of reading a stale tangent. */
+static int tangent_for_products(StepProblem *pb)
+{
+    return pb->tangent_stored ? MPM_OK : problem_tangent(pb, pb->tangent_projected);
 }
 
 /* B_s[a][3c+d] = sum_b A[(a,b),(c,d)] a_s(b): the particle tangent contracted
@@ -594,38 +616,56 @@ static void finish_row(const StepProblem *pb, Bsr *H, int i)
     }
 }
 
-int problem_assemble(StepProblem *pb, Bsr *H)
+/* The tangent of particles [k0, k1) into A (81 numbers each). */
+static void tangent_range(const StepProblem *pb, int projected, size_t k0, size_t k1, double *A)
 {
-    int status;
-    if (!pb->pattern_ready || H->n != pb->n_nodes) {
-        if ((status = build_pattern(pb, H))) return status;
-    }
+    for (size_t k = k0; k < k1; ++k) fcr_dPdF(pb->F + 9 * k, pb->mu[k], pb->lambda[k], projected, A + 81 * (k - k0));
+}
+
+/* The Hessian's blocks (i, j >= i) from the particles' tangents: pb->A
+ * when fused is 0, otherwise computed particle block by particle block into
+ * a per-thread buffer that stays in cache (the same values: fcr_dPdF's). */
+static int assemble_cells(StepProblem *pb, Bsr *H, int fused, int projected)
+{
     const Stencils *st = pb->st;
     const Particles *p = pb->parts;
-    double dt2 = pb->dt * pb->dt;
-    /* zero the blocks (i, j >= i), the row's tail (sorted columns); finish_row writes the others */
-#pragma omp parallel for schedule(static)
-    for (int i = 0; i < pb->n_nodes; ++i) {
-        int64_t kd = H->row_ptr[i];
-        while (kd < H->row_ptr[i + 1] && H->col[kd] < i) ++kd;
-        memset(H->val + 9 * kd, 0, sizeof(double) * 9 * (size_t)(H->row_ptr[i + 1] - kd));
-    }
+    const double dt2 = pb->dt * pb->dt;
     const NodeColoring *pc = &st->pcolor;
-    for (int c = 0; c < MPM_NUM_COLORS; ++c) {
+    int oom = 0;
 #pragma omp parallel
-        {
-            /* particles sharing a base node share all 27 stencil nodes: sum
-             * them in a dense cell buffer, scatter once per cell */
-            static _Thread_local _Alignas(32) double Kloc[HESSIAN_CELL_SIZE]; /* no allocation per call */
+    {
+        /* particles sharing a base node share all 27 stencil nodes: sum
+         * them in a dense cell buffer, scatter once per cell */
+        static _Thread_local _Alignas(32) double Kloc[HESSIAN_CELL_SIZE]; /* no allocation per call */
+        double *Ablock = NULL;
+        size_t cap = 0;
+        int failed = 0;
+        for (int c = 0; c < MPM_NUM_COLORS; ++c) {
 #pragma omp for schedule(dynamic, 2)
             for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
                 int q = pc->color_blocks[qi];
-                int k = pc->block_start[q], kend = pc->block_start[q + 1];
+                int k0 = pc->block_start[q], kend = pc->block_start[q + 1];
+                const double *A0 = pb->A ? pb->A + 81 * (size_t)k0 : NULL;
+                if (fused) {
+                    size_t need = (size_t)(kend - k0);
+                    if (need > cap) {
+                        double *grown = realloc(Ablock, sizeof(double) * 81 * need);
+                        if (!grown) {
+                            failed = 1;
+                            continue;
+                        }
+                        Ablock = grown;
+                        cap = need;
+                    }
+                    tangent_range(pb, projected, (size_t)k0, (size_t)kend, Ablock);
+                    A0 = Ablock;
+                }
+                int k = k0;
                 while (k < kend) {
                     const int *b0 = st->base + 3 * (size_t)k;
                     int k1 = k + 1;
                     while (k1 < kend && memcmp(st->base + 3 * (size_t)k1, b0, 3 * sizeof(int)) == 0) ++k1;
-                    hessian_cell(k1 - k, pb->A + 81 * (size_t)k, pb->a + 81 * (size_t)k, p->vol + k, dt2, Kloc,
+                    hessian_cell(k1 - k, A0 + 81 * (size_t)(k - k0), pb->a + 81 * (size_t)k, p->vol + k, dt2, Kloc,
                                  pb->cell_kernel);
                     /* node ids of the cell: union over its particles (a node
                      * is -1 only where every weight vanishes) */
@@ -639,10 +679,47 @@ int problem_assemble(StepProblem *pb, Bsr *H)
                 }
             }
         }
+        free(Ablock);
+        if (failed) {
+#pragma omp atomic write
+            oom = 1;
+        }
     }
+    if (oom) return mpm_error(MPM_EINTERNAL, "out of memory: tangents of a particle block in the assembly");
+    return MPM_OK;
+}
+
+static int assemble(StepProblem *pb, Bsr *H, int fused, int projected)
+{
+    int status;
+    if (!pb->pattern_ready || H->n != pb->n_nodes) {
+        if ((status = build_pattern(pb, H))) return status;
+    }
+    /* zero the blocks (i, j >= i), the row's tail (sorted columns); finish_row writes the others */
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < pb->n_nodes; ++i) {
+        int64_t kd = H->row_ptr[i];
+        while (kd < H->row_ptr[i + 1] && H->col[kd] < i) ++kd;
+        memset(H->val + 9 * kd, 0, sizeof(double) * 9 * (size_t)(H->row_ptr[i + 1] - kd));
+    }
+    if ((status = assemble_cells(pb, H, fused, projected))) return status;
 #pragma omp parallel for schedule(dynamic, 64)
     for (int i = 0; i < pb->n_nodes; ++i) finish_row(pb, H, i);
     return MPM_OK;
+}
+
+int problem_assemble(StepProblem *pb, Bsr *H)
+{
+    if (!pb->tangent_stored)
+        return mpm_error(MPM_EINTERNAL, "problem_assemble: no tangent stored (problem_tangent first)");
+    return assemble(pb, H, 0, pb->tangent_projected);
+}
+
+int problem_assemble_fused(StepProblem *pb, int projected, Bsr *H)
+{
+    pb->tangent_stored = 0; /* pb->A is not updated */
+    pb->tangent_projected = projected;
+    return assemble(pb, H, 1, projected);
 }
 
 void problem_hessvec(StepProblem *pb, const double *x, double *y)
@@ -652,6 +729,10 @@ void problem_hessvec(StepProblem *pb, const double *x, double *y)
     const double *m = pb->grid->mass;
     double dt2 = pb->dt * pb->dt;
     int n = pb->n_nodes;
+    if (tangent_for_products(pb)) {
+        for (size_t e = 0; e < 3 * (size_t)n; ++e) y[e] = NAN;
+        return;
+    }
     const double *xp = x;
     if (pb->n_dirichlet) {
         memcpy(pb->tmp, x, sizeof(double) * 3 * (size_t)n);
@@ -725,6 +806,10 @@ void problem_diagonal(StepProblem *pb, double *D)
     const double *m = pb->grid->mass;
     double dt2 = pb->dt * pb->dt;
     int n = pb->n_nodes;
+    if (tangent_for_products(pb)) {
+        for (size_t e = 0; e < 9 * (size_t)n; ++e) D[e] = NAN;
+        return;
+    }
 #pragma omp parallel for schedule(static)
     for (int i = 0; i < n; ++i) {
         double *Di = D + 9 * (size_t)i;

@@ -16,7 +16,8 @@
  * at dv and caches them; problem_gradient() then scatters the cached stress;
  * problem_tangent() computes the (projected) dP/dF per particle from the
  * cached F, after which problem_assemble, problem_hessvec and
- * problem_diagonal are available. */
+ * problem_diagonal are available; problem_assemble_fused assembles without
+ * keeping the tangents. */
 #ifndef MPM_PROBLEM_H
 #define MPM_PROBLEM_H
 
@@ -63,8 +64,10 @@ typedef struct StepProblem {
 
     /* iterate cache */
     double *F, *P;       /* 9 per particle at the last problem_energy point */
-    double *A;           /* 81 per particle after problem_tangent */
+    double *A;           /* 81 per particle after problem_tangent (allocated by it) */
+    size_t cap_A;
     int tangent_projected;
+    int tangent_stored;  /* A holds the tangent at the cached F (problem_tangent since the last energy) */
     int stress_kernel;   /* FCR4_AUTO (0) or _PORTABLE: the energy's psi and P kernel (core/fcr4.h) */
     int gradient_kernel; /* GRADIENT_CELL_AUTO (0) or _PORTABLE: the gradient's cell kernel (core/gradient_cell.h) */
     int cell_kernel;     /* HESSIAN_CELL_AUTO (0) or _PORTABLE: the assembly's cell kernel (core/hessian_cell.h) */
@@ -112,12 +115,24 @@ double problem_energy(StepProblem *pb, const double *dv);
 /* Projected gradient at the point of the last problem_energy call. */
 void problem_gradient(StepProblem *pb, const double *dv, double *g);
 
-/* dP/dF per particle at the cached F (projected to SPD when asked). */
+/* dP/dF per particle at the cached F (projected to SPD when asked), kept in
+ * pb->A for problem_assemble, problem_hessvec and problem_diagonal. */
 int problem_tangent(StepProblem *pb, int projected);
 
+/* pb->A with room for the current particles (allocated on first use), for
+ * a caller that fills the tangents itself (GMG's rediscretised levels);
+ * NULL when out of memory. */
+double *problem_tangent_storage(StepProblem *pb);
+
 /* Assembles the BC-projected Hessian into H (pattern built once per step,
- * storage reused). Requires problem_tangent. */
+ * storage reused) from the tangents of problem_tangent. */
 int problem_assemble(StepProblem *pb, Bsr *H);
+
+/* The same Hessian (bit for bit) with the tangent computed particle block
+ * by particle block as the assembly goes and not kept: no 648 bytes a
+ * particle written and read back. pb->A is left unset; problem_hessvec and
+ * problem_diagonal compute the tangent again if called after it. */
+int problem_assemble_fused(StepProblem *pb, int projected, Bsr *H);
 
 /* y = (P H P + I - P) x, matrix-free (SPEC 3). Requires problem_tangent. */
 void problem_hessvec(StepProblem *pb, const double *x, double *y);

@@ -140,8 +140,11 @@ void solve_projection(SolveCtx *c, Projection *P)
 static int assemble(SolveCtx *c, int projected, Bsr *H, double *diag, SolveStats *st)
 {
     double t0 = omp_get_wtime();
-    int status = problem_tangent(c->pb, projected);
-    if (!status && H) status = problem_assemble(c->pb, H);
+    /* Assembled: the tangent is used once, by the assembly, unless the
+     * inverse rediscretises from the particles' stored tangents (GMG). */
+    int status;
+    if (H && !(c->inv->caps & INV_NEEDS_PROBLEM)) status = problem_assemble_fused(c->pb, projected, H);
+    else if (!(status = problem_tangent(c->pb, projected)) && H) status = problem_assemble(c->pb, H);
     if (!status) {
         if (H) bsr_diagonal(H, diag);
         else problem_diagonal(c->pb, diag);

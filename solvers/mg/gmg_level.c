@@ -24,6 +24,8 @@ int gmg_level_build(GmgLevel *L, const StepProblem *fine, double h, Bsr *A)
     const Particles *fp = fine->parts;
     size_t n = fp->n;
     int st;
+    if (!fine->tangent_stored)
+        return mpm_error(MPM_EINTERNAL, "multigrid level: the fine problem has no stored tangent (problem_tangent)");
     /* visit particles in this level's cell order, so grid_build finds them
      * sorted and the copied tangents stay aligned with the particles */
     KeyIdx *ki = malloc(sizeof(KeyIdx) * (n ? n : 1));
@@ -62,8 +64,14 @@ int gmg_level_build(GmgLevel *L, const StepProblem *fine, double h, Bsr *A)
         return st;
     }
     problem_mark_dirichlet(&L->pb, fine->dirichlet_fn, fine->dirichlet_ctx);
-    for (size_t k = 0; k < n; ++k) memcpy(L->pb.A + 81 * k, fine->A + 81 * ki[k].idx, 81 * sizeof(double));
+    double *LA = problem_tangent_storage(&L->pb);
+    if (!LA) {
+        free(ki);
+        return MPM_EINTERNAL;
+    }
+    for (size_t k = 0; k < n; ++k) memcpy(LA + 81 * k, fine->A + 81 * ki[k].idx, 81 * sizeof(double));
     L->pb.tangent_projected = fine->tangent_projected;
+    L->pb.tangent_stored = 1;
     free(ki);
     return problem_assemble(&L->pb, A);
 }

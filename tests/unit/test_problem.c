@@ -196,6 +196,49 @@ static void test_assembled_equals_matrix_free(int with_bc, int mls)
     fixture_free(&f);
 }
 
+/* problem_assemble_fused: the Hessian of tangent + assemble bit for bit
+ * (projected and not, with Dirichlet nodes), without pb->A; afterwards
+ * H x matrix-free computes the tangent it needs, and problem_assemble
+ * refuses to run on a stale tangent. */
+static void test_fused_assembly(int mls)
+{
+    FixtureOptions o;
+    fixture_default(&o);
+    o.mls = mls;
+    o.two_materials = 1;
+    o.per_axis = 8;
+    o.F_noise = 0.3;
+    o.inverted_fraction_pct = 10;
+    Fixture f;
+    CHECK(fixture_build(&f, &o) == 0, "fixture");
+    mark_some_dirichlet(&f.pb);
+    int n = f.pb.n_nodes;
+    double *dv = alloc3(n), *x = alloc3(n), *y1 = alloc3(n), *y2 = alloc3(n);
+    unsigned long long seed = 11;
+    random_vec(n, dv, &seed, 0.05);
+    random_vec(n, x, &seed, 1.0);
+    for (int projected = 0; projected <= 1; ++projected) {
+        Bsr H1 = {0}, H2 = {0};
+        problem_energy(&f.pb, dv);
+        CHECK(problem_assemble(&f.pb, &H1) != 0, "problem_assemble without a tangent is refused");
+        problem_tangent(&f.pb, projected);
+        CHECK(problem_assemble(&f.pb, &H1) == 0, "assemble");
+        problem_energy(&f.pb, dv);
+        CHECK(problem_assemble_fused(&f.pb, projected, &H2) == 0, "fused assembly");
+        CHECK(!f.pb.tangent_stored, "the fused assembly keeps no tangent");
+        int same = H1.nnzb == H2.nnzb && memcmp(H1.val, H2.val, sizeof(double) * 9 * (size_t)H1.nnzb) == 0;
+        CHECK(same, "mls=%d projected=%d: fused and stored-tangent Hessians differ", mls, projected);
+        double rel = assembled_vs_matrix_free(&f, &H2, x, y1, y2);
+        CHECK(rel < 1e-14, "mls=%d projected=%d: fused H x vs matrix-free after it: rel diff %.3e", mls, projected,
+              rel);
+        CHECK(f.pb.tangent_stored && f.pb.tangent_projected == projected, "H x stored the tangent it needed");
+        bsr_free(&H1);
+        bsr_free(&H2);
+    }
+    free(dv), free(x), free(y1), free(y2);
+    fixture_free(&f);
+}
+
 static void test_projected_hessian_spd(int inverted_pct, double F_noise, const char *what, int mls)
 {
     FixtureOptions o;
@@ -349,6 +392,7 @@ int main(void)
         test_hessian_fd(mls);
         test_assembled_equals_matrix_free(0, mls);
         test_assembled_equals_matrix_free(1, mls);
+        test_fused_assembly(mls);
         test_projected_hessian_spd(0, 0.4, "random", mls);
         test_projected_hessian_spd(50, 0.3, "inverted", mls);
         test_projected_hessian_spd(0, 0.0, "near-degenerate", mls);
