@@ -327,11 +327,17 @@ void problem_gradient(StepProblem *pb, const double *dv, double *grad)
     problem_project(pb, grad);
 }
 
+/* Four particles at a time share the SIMD lanes of the SVD and of the rank-9
+ * sum (core/fcr4.h; the scalar fcr_dPdF's bits), the last n mod 4 alone. */
 int problem_tangent(StepProblem *pb, int projected)
 {
     const Particles *p = pb->parts;
+    size_t n4 = p->n / 4;
 #pragma omp parallel for schedule(static)
-    for (size_t k = 0; k < p->n; ++k) fcr_dPdF(pb->F + 9 * k, pb->mu[k], pb->lambda[k], projected, pb->A + 81 * k);
+    for (size_t q = 0; q < n4; ++q)
+        fcr_dPdF4(pb->F + 36 * q, pb->mu + 4 * q, pb->lambda + 4 * q, projected, pb->A + 324 * q, pb->stress_kernel);
+    for (size_t k = 4 * n4; k < p->n; ++k)
+        fcr_dPdF(pb->F + 9 * k, pb->mu[k], pb->lambda[k], projected, pb->A + 81 * k);
     pb->tangent_projected = projected;
     return MPM_OK;
 }

@@ -310,6 +310,7 @@ int bench_run(const char *what, const RunConfig *cfg)
     if (all || !strcmp(what, "tangent")) {
         double t = machine_best_time(run_tangent, &bc, min_s, &spread);
         report(&L, model_tangent(ENERGY_SVD_TESTS, ENERGY_SVD_ROTATIONS), t, spread, "tangent");
+        printf("tangent_kernel_isa=%s\n", fcr4_isa());
     }
     if (all || !strcmp(what, "energy")) {
         /* a trial point off the initial guess, as a line search's: dv0 + 1e-3 x */
