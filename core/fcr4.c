@@ -17,12 +17,14 @@ static void fcr4_portable(const double *F, const double *mu, const double *lambd
     for (int l = 0; l < 4; ++l) psi[l] = fcr_psi_P(F + 9 * l, mu[l], lambda[l], P + 9 * l);
 }
 
+/* NaN is tested first, so a compare replaces fmax (a libm call here). */
 int fcr4_usual(const double *F)
 {
     double m = 0.0;
     for (int k = 0; k < 9; ++k) {
-        if (isnan(F[k])) return 0;
-        m = fmax(m, fabs(F[k]));
+        double a = fabs(F[k]);
+        if (isnan(a)) return 0;
+        if (a > m) m = a;
     }
     return m >= 0x1p-128 && m <= 0x1p128;
 }
