@@ -111,10 +111,6 @@ static int ensure_stencils(Stencils *st, size_t n)
     void *p;
     if (!(p = realloc(st->node, sizeof(int) * MPM_STENCIL * cap))) goto oom;
     st->node = p;
-    if (!(p = realloc(st->w, sizeof(double) * MPM_STENCIL * cap))) goto oom;
-    st->w = p;
-    if (!(p = realloc(st->dw, sizeof(double) * 3 * MPM_STENCIL * cap))) goto oom;
-    st->dw = p;
     if (!(p = realloc(st->f1d, sizeof(double) * 18 * cap))) goto oom;
     st->f1d = p;
     if (!(p = realloc(st->base, sizeof(int) * 3 * cap))) goto oom;
@@ -162,6 +158,8 @@ static int sort_particles(Particles *p, Stencils *st, double inv_dx)
     return MPM_OK;
 }
 
+static inline int same_cell(const int a[3], const int b[3]) { return a[0] == b[0] && a[1] == b[1] && a[2] == b[2]; }
+
 static int cmp_u64(const void *a, const void *b)
 {
     uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
@@ -185,7 +183,8 @@ int grid_build(Grid *g, Stencils *st, Particles *p, double dx)
     if ((status = node_coloring_build(bb, (int)np, &st->pcolor))) return status;
     int npb = st->pcolor.n_blocks;
 
-    /* Weights and gradients (parallel, per particle). */
+    /* 1D weight factors (parallel, per particle); the 27 weights and their
+     * gradients are their products (stencil_weights). */
     st->mls = 0;
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < np; ++k) {
@@ -193,16 +192,6 @@ int grid_build(Grid *g, Stencils *st, Particles *p, double dx)
         for (int d = 0; d < 3; ++d) bspline2_1d(p->x[3 * k + d], inv_dx, N[d], dN[d]);
         memcpy(st->f1d + 18 * k, N, sizeof N);
         memcpy(st->f1d + 18 * k + 9, dN, sizeof dN);
-        double *w = st->w + MPM_STENCIL * k, *dw = st->dw + 3 * MPM_STENCIL * k;
-        for (int a = 0; a < 3; ++a)
-            for (int b = 0; b < 3; ++b)
-                for (int c = 0; c < 3; ++c) {
-                    int s = stencil_slot(a, b, c);
-                    w[s] = N[0][a] * N[1][b] * N[2][c];
-                    dw[3 * s] = dN[0][a] * N[1][b] * N[2][c];
-                    dw[3 * s + 1] = N[0][a] * dN[1][b] * N[2][c];
-                    dw[3 * s + 2] = N[0][a] * N[1][b] * dN[2][c];
-                }
     }
 
     /* Blocks touched: each particle block b touches node blocks b + {0,1}^3. */
@@ -224,11 +213,19 @@ int grid_build(Grid *g, Stencils *st, Particles *p, double dx)
             int q = st->pcolor.color_blocks[qi];
             const int *b0 = st->base + 3 * (size_t)st->pcolor.block_start[q];
             int B[3] = {floor_div_pow2(b0[0], 2) * 4, floor_div_pow2(b0[1], 2) * 4, floor_div_pow2(b0[2], 2) * 4};
-            for (int k = st->pcolor.block_start[q]; k < st->pcolor.block_start[q + 1]; ++k) {
+            /* Particles come sorted by cell: OR the cell's slots with a
+             * weight first, then set their bits once per cell. */
+            int k = st->pcolor.block_start[q], k_end = st->pcolor.block_start[q + 1];
+            while (k < k_end) {
                 const int *base = st->base + 3 * (size_t)k;
-                const double *w = st->w + MPM_STENCIL * (size_t)k;
+                uint32_t slots = 0;
+                for (; k < k_end && same_cell(st->base + 3 * (size_t)k, base); ++k) {
+                    double w[MPM_STENCIL];
+                    stencil_weights(st, (size_t)k, w, NULL);
+                    for (int s = 0; s < MPM_STENCIL; ++s) slots |= (uint32_t)(w[s] > 0.0) << s;
+                }
                 for (int s = 0; s < MPM_STENCIL; ++s) {
-                    if (!(w[s] > 0.0)) continue;
+                    if (!((slots >> s) & 1u)) continue;
                     int r[3] = {base[0] + s / 9 - B[0], base[1] + (s / 3) % 3 - B[1], base[2] + s % 3 - B[2]};
                     int o = ((r[0] >> 2) << 2) | ((r[1] >> 2) << 1) | (r[2] >> 2);
                     int l = ((r[0] & 3) << 4) | ((r[1] & 3) << 2) | (r[2] & 3);
@@ -305,18 +302,26 @@ int grid_build(Grid *g, Stencils *st, Particles *p, double dx)
     if ((status = node_coloring_build(g->coord, n, &g->coloring))) return status;
 
     /* Stencil node ids. */
-#pragma omp parallel for schedule(static)
-    for (size_t k = 0; k < np; ++k) {
-        const int *base = st->base + 3 * k;
-        const double *w = st->w + MPM_STENCIL * k;
-        int *node = st->node + MPM_STENCIL * k;
-        for (int s = 0; s < MPM_STENCIL; ++s) {
-            if (!(w[s] > 0.0)) {
-                node[s] = -1;
-                continue;
+    /* The 27 lookups are made once per cell (particles sorted by cell share
+     * them) and masked by each particle's own weights. */
+#pragma omp parallel
+    {
+        int cell_node[MPM_STENCIL];
+        const int *cell = NULL;
+#pragma omp for schedule(static)
+        for (size_t k = 0; k < np; ++k) {
+            const int *base = st->base + 3 * k;
+            if (!cell || !same_cell(cell, base)) {
+                cell = base;
+                for (int s = 0; s < MPM_STENCIL; ++s) {
+                    int c[3] = {base[0] + s / 9, base[1] + (s / 3) % 3, base[2] + s % 3};
+                    cell_node[s] = grid_lookup(g, c);
+                }
             }
-            int c[3] = {base[0] + s / 9, base[1] + (s / 3) % 3, base[2] + s % 3};
-            node[s] = grid_lookup(g, c);
+            double w[MPM_STENCIL];
+            stencil_weights(st, k, w, NULL);
+            int *node = st->node + MPM_STENCIL * k;
+            for (int s = 0; s < MPM_STENCIL; ++s) node[s] = w[s] > 0.0 ? cell_node[s] : -1;
         }
     }
     return MPM_OK;
@@ -335,15 +340,6 @@ void stencils_use_mls_gradients(Stencils *st, const Particles *p, double dx)
             mls_factor_1d(p->x[3 * k + d], inv_dx, b, N[d], G[d]);
         }
         memcpy(st->f1d + 18 * k + 9, G, sizeof G);
-        double *dw = st->dw + 3 * MPM_STENCIL * k;
-        for (int a = 0; a < 3; ++a)
-            for (int b = 0; b < 3; ++b)
-                for (int c = 0; c < 3; ++c) {
-                    int s = stencil_slot(a, b, c);
-                    dw[3 * s] = G[0][a] * N[1][b] * N[2][c];
-                    dw[3 * s + 1] = N[0][a] * G[1][b] * N[2][c];
-                    dw[3 * s + 2] = N[0][a] * N[1][b] * G[2][c];
-                }
     }
     st->mls = 1;
 }
@@ -364,8 +360,6 @@ void grid_free(Grid *g)
 void stencils_free(Stencils *st)
 {
     free(st->node);
-    free(st->w);
-    free(st->dw);
     free(st->f1d);
     free(st->base);
     free(st->perm);

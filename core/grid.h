@@ -45,18 +45,39 @@ typedef struct {
 typedef struct {
     size_t n, cap;
     int *node;     /* 27 per particle: node id, -1 where the weight is exactly 0 */
-    double *w;     /* 27 per particle */
-    double *dw;    /* 81 per particle: weight gradients (27 x 3), or their MLS substitute */
-    int mls;       /* 1: dw holds the MLS substitute (stencils_use_mls_gradients) */
-    double *f1d;   /* 18 per particle: w and dw as tensor products, N[d][k] (9) then D[d][k] (9),
-                    * D = dN or the MLS factor: for slot s = 9a + 3b + c, w_s = N0a N1b N2c and
-                    * dw_s = (D0a N1b N2c, N0a D1b N2c, N0a N1b D2c) (the gradient reads these
-                    * 144 bytes instead of 648) */
+    int mls;       /* 1: f1d's D holds the MLS substitute (stencils_use_mls_gradients) */
+    double *f1d;   /* 18 per particle: the weights w and their gradients dw as tensor products,
+                    * N[d][k] (9) then D[d][k] (9), D = dN or the MLS factor: for slot
+                    * s = 9a + 3b + c, w_s = N0a N1b N2c and dw_s = (D0a N1b N2c, N0a D1b N2c,
+                    * N0a N1b D2c). Kernels read these 144 bytes instead of 864 of stored w
+                    * and dw (stencil_weights) */
     NodeColoring pcolor; /* particle blocks (particles sorted by base-node block) */
     int *base;     /* 3 per particle: base node */
     size_t *perm;  /* sort scratch */
     double *scratch;
 } Stencils;
+
+/* The 27 weights w and, unless dw is NULL, the 81 weight gradients of
+ * particle k (slot s = 9a + 3b + c; dw[3s + d]), rebuilt from its 1D
+ * factors in the products' fixed order, so bit for bit the same values
+ * every time and in every kernel. */
+static inline void stencil_weights(const Stencils *st, size_t k, double w[27], double *dw)
+{
+    const double *N = st->f1d + 18 * k, *D = N + 9;
+    for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) {
+            double nn = N[a] * N[3 + b], dn = D[a] * N[3 + b], nd = N[a] * D[3 + b];
+            for (int c = 0; c < 3; ++c) {
+                int s = 9 * a + 3 * b + c;
+                w[s] = nn * N[6 + c];
+                if (dw) {
+                    dw[3 * s] = dn * N[6 + c];
+                    dw[3 * s + 1] = nd * N[6 + c];
+                    dw[3 * s + 2] = nn * D[6 + c];
+                }
+            }
+        }
+}
 
 /* Sorts particles by base-node block, finds the active nodes, numbers them
  * and fills the stencils. Allocates only when sizes grow. */

@@ -93,7 +93,9 @@ int problem_prepare(StepProblem *pb, const Grid *g, const Stencils *st, const Pa
         pb->stiff[k] = fcr_rest_stiffness(pb->mu[k], pb->lambda[k]);
         if (pb->stiff[k] > maxstiff) maxstiff = pb->stiff[k];
         /* a_ip = F^nT grad w_ip */
-        const double *Fn = p->F + 9 * k, *dw = st->dw + 81 * k;
+        const double *Fn = p->F + 9 * k;
+        double w[27], dw[81];
+        stencil_weights(st, k, w, dw);
         double *a = pb->a + 81 * k;
         for (int s = 0; s < 27; ++s) {
             const double *gw = dw + 3 * s;
@@ -114,7 +116,8 @@ int problem_prepare(StepProblem *pb, const Grid *g, const Stencils *st, const Pa
             int q = pc->color_blocks[qi];
             for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
                 const int *node = st->node + 27 * (size_t)k;
-                const double *w = st->w + 27 * (size_t)k;
+                double w[27];
+                stencil_weights(st, (size_t)k, w, NULL);
                 double s = p->mass[k] * pb->stiff[k];
                 for (int t = 0; t < 27; ++t)
                     if (node[t] >= 0) num[node[t]] += w[t] * s;

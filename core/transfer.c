@@ -20,7 +20,8 @@ void transfer_p2g(Grid *g, const Stencils *st, const Particles *p)
                 const double *xp = p->x + 3 * (size_t)k, *vp = p->v + 3 * (size_t)k, *Cp = p->C + 9 * (size_t)k;
                 const int *base = st->base + 3 * (size_t)k;
                 const int *node = st->node + MPM_STENCIL * (size_t)k;
-                const double *w = st->w + MPM_STENCIL * (size_t)k;
+                double w[MPM_STENCIL];
+                stencil_weights(st, (size_t)k, w, NULL);
                 double mp = p->mass[k];
                 for (int s = 0; s < MPM_STENCIL; ++s) {
                     int i = node[s];
@@ -92,7 +93,8 @@ void transfer_p2g_apic_force(Grid *g, const Stencils *st, const Particles *p, co
                 const double *xp = p->x + 3 * (size_t)k, *vp = p->v + 3 * (size_t)k, *Cp = p->C + 9 * (size_t)k;
                 const int *base = st->base + 3 * (size_t)k;
                 const int *node = st->node + MPM_STENCIL * (size_t)k;
-                const double *w = st->w + MPM_STENCIL * (size_t)k, *dw = st->dw + 3 * MPM_STENCIL * (size_t)k;
+                double w[MPM_STENCIL], dw[3 * MPM_STENCIL];
+                stencil_weights(st, (size_t)k, w, dw);
                 double mp = p->mass[k], K[9] = {0};
                 if (force) {
                     transfer_explicit_stress(force, p, (size_t)k, K);
@@ -134,7 +136,8 @@ void transfer_p2g_mls(Grid *g, const Stencils *st, const Particles *p, const Exp
                 const double *xp = p->x + 3 * (size_t)k, *vp = p->v + 3 * (size_t)k, *Cp = p->C + 9 * (size_t)k;
                 const int *base = st->base + 3 * (size_t)k;
                 const int *node = st->node + MPM_STENCIL * (size_t)k;
-                const double *w = st->w + MPM_STENCIL * (size_t)k;
+                double w[MPM_STENCIL];
+                stencil_weights(st, (size_t)k, w, NULL);
                 double mp = p->mass[k], Q[9], mv[3] = {mp * vp[0], mp * vp[1], mp * vp[2]};
                 for (int e = 0; e < 9; ++e) Q[e] = mp * Cp[e];
                 if (force) { /* Q_p = m_p C_p - dt V_p D_p^-1 P F^T (supplement 3.1) */
@@ -173,7 +176,8 @@ void transfer_g2p_opts(const Grid *g, const Stencils *st, Particles *p, const do
         double *xp = p->x + 3 * k;
         const int *base = st->base + 3 * k;
         const int *node = st->node + MPM_STENCIL * k;
-        const double *w = st->w + MPM_STENCIL * k, *dw = st->dw + 3 * MPM_STENCIL * k;
+        double w[MPM_STENCIL], dw[3 * MPM_STENCIL];
+        stencil_weights(st, k, w, dw);
         double v[3] = {0, 0, 0}, B[9] = {0}, G[9] = {0}, dvw[3] = {0, 0, 0};
         for (int s = 0; s < MPM_STENCIL; ++s) {
             int i = node[s];
@@ -237,7 +241,8 @@ void transfer_volumes_from_density(const Grid *g, const Stencils *st, Particles 
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < p->n; ++k) {
         const int *node = st->node + MPM_STENCIL * k;
-        const double *w = st->w + MPM_STENCIL * k;
+        double w[MPM_STENCIL];
+        stencil_weights(st, k, w, NULL);
         double wm = 0.0;
         for (int s = 0; s < MPM_STENCIL; ++s)
             if (node[s] >= 0) wm += w[s] * g->mass[node[s]];

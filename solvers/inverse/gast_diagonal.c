@@ -78,7 +78,8 @@ static int gd_setup(InvApprox *self, const InvSetupInput *in)
             int q = pc->color_blocks[qi];
             for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
                 const int *node = st->node + 27 * (size_t)k;
-                const double *dw = st->dw + 81 * (size_t)k;
+                double w[27], dw[81];
+                stencil_weights(st, (size_t)k, w, dw);
                 const double s = dt2 * p->vol[k], lm = pb->lambda[k] + pb->mu[k], mu = pb->mu[k];
                 for (int t = 0; t < 27; ++t) {
                     int i = node[t];

@@ -173,7 +173,9 @@ static void reference(StepProblem *pb, const double *dv, Reference *R)
         S += fabsl((long double)t);
     }
     for (size_t k = 0; k < p->n; ++k) {
-        const double *Fn = p->F + 9 * k, *dw = st->dw + 81 * k;
+        const double *Fn = p->F + 9 * k;
+        double wk[27], dw[81];
+        stencil_weights(st, k, wk, dw);
         const int *node = st->node + 27 * k;
         double a[27][3], F[9], P[9];
         for (int s = 0; s < 27; ++s)

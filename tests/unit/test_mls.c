@@ -58,16 +58,19 @@ static void test_substitute_direct(void)
     Fixture f;
     build(&f, 1, 6);
     double dx = f.g.dx, worst = 0, scale = 0;
-    for (size_t k = 0; k < f.p.n; ++k)
+    for (size_t k = 0; k < f.p.n; ++k) {
+        double w[27], dw[81];
+        stencil_weights(&f.st, k, w, dw);
         for (int s = 0; s < 27; ++s) {
             double xi[3];
             node_position(&f.st, k, s, dx, xi);
             for (int d = 0; d < 3; ++d) {
-                double want = f.st.w[27 * k + s] * 4.0 / (dx * dx) * (xi[d] - f.p.x[3 * k + d]);
-                worst = fmax(worst, fabs(f.st.dw[81 * k + 3 * s + d] - want));
+                double want = w[s] * 4.0 / (dx * dx) * (xi[d] - f.p.x[3 * k + d]);
+                worst = fmax(worst, fabs(dw[3 * s + d] - want));
                 scale = fmax(scale, fabs(want));
             }
         }
+    }
     CHECK(f.st.mls == 1, "stencils marked MLS");
     CHECK(worst <= 1e-13 * scale, "MLS substitute vs w 4/dx^2 (x_i - x_p): max diff %.3e of %.3e", worst, scale);
     fixture_free(&f);
@@ -89,12 +92,13 @@ static void test_affine_reproduction(void)
     /* the gradient substitute itself */
     double worst = 0;
     for (size_t k = 0; k < f.p.n; ++k) {
-        double G[9] = {0};
+        double G[9] = {0}, w[27], dw[81];
+        stencil_weights(&f.st, k, w, dw);
         for (int s = 0; s < 27; ++s) {
             int i = f.st.node[27 * k + s];
             if (i < 0) continue;
             for (int a = 0; a < 3; ++a)
-                for (int c = 0; c < 3; ++c) G[3 * a + c] += vnew[3 * i + a] * f.st.dw[81 * k + 3 * s + c];
+                for (int c = 0; c < 3; ++c) G[3 * a + c] += vnew[3 * i + a] * dw[3 * s + c];
         }
         worst = fmax(worst, max_diff(G, A, 9));
     }
@@ -183,6 +187,8 @@ static void test_apic_mls_equivalence(void)
     double ev = 0, eC = 0, eF = 0, moff = 0;
     for (size_t k = 0; k < np; ++k) {
         double M[4][4] = {{0}}, r[4][3] = {{0}}, c[4][3];
+        double wk[27];
+        stencil_weights(&f.st, k, wk, NULL);
         for (int s = 0; s < 27; ++s) {
             int i = f.st.node[27 * k + s];
             if (i < 0) continue;
@@ -190,7 +196,7 @@ static void test_apic_mls_equivalence(void)
             node_position(&f.st, k, s, dx, xi);
             P[0] = 1.0;
             for (int d = 0; d < 3; ++d) P[d + 1] = xi[d] - f.p.x[3 * k + d];
-            double w = f.st.w[27 * k + s];
+            double w = wk[s];
             for (int a = 0; a < 4; ++a) {
                 for (int b = 0; b < 4; ++b) M[a][b] += w * P[a] * P[b];
                 for (int d = 0; d < 3; ++d) r[a][d] += w * P[a] * vnew[3 * i + d];
@@ -312,7 +318,7 @@ static void test_fused_force(void)
     transfer_p2g_mls(&f.g, &f.st, &f.p, &force);
     double *fused = malloc(sizeof(double) * len);
     memcpy(fused, f.g.v, sizeof(double) * len);
-    transfer_p2g_apic_force(&f.g, &f.st, &f.p, &force); /* reads the MLS gradients in st->dw */
+    transfer_p2g_apic_force(&f.g, &f.st, &f.p, &force); /* reads the MLS gradient factors in st->f1d */
     double e = max_diff(fused, f.g.v, len), s = max_abs(f.g.v, len);
     CHECK(e <= 1e-12 * s, "fused Q_p P2G = momentum + dt f_i with MLS gradients: %.3e of %.3e", e, s);
     /* and the force matters (not a vacuous comparison) */

@@ -50,11 +50,12 @@ int main(void)
     double *pic = calloc(3 * np, sizeof(double)), *flip = calloc(3 * np, sizeof(double)),
            *blend = calloc(3 * np, sizeof(double)), *xpic = calloc(3 * np, sizeof(double));
     for (size_t k = 0; k < np; ++k) {
-        double inc[3] = {0, 0, 0};
+        double inc[3] = {0, 0, 0}, wk[27];
+        stencil_weights(&f.st, k, wk, NULL);
         for (int s = 0; s < 27; ++s) {
             int i = f.st.node[27 * k + s];
             if (i < 0) continue;
-            double w = f.st.w[27 * k + s];
+            double w = wk[s];
             for (int d = 0; d < 3; ++d) {
                 pic[3 * k + d] += w * vnew[3 * i + d];
                 inc[d] += w * (vnew[3 * i + d] - f.g.v[3 * i + d]);

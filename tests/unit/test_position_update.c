@@ -157,11 +157,12 @@ static void test_field(void)
         double vn[3], Gn[9];
         grid_velocity_at(&f.g, vel, f.p.x + 3 * k, NULL, NULL, vn, Gn);
         /* at its own position a particle's stencil is complete: plain interpolation sum w v */
-        double ref[3] = {0, 0, 0};
+        double ref[3] = {0, 0, 0}, wk[27];
+        stencil_weights(&f.st, k, wk, NULL);
         for (int s = 0; s < 27; ++s) {
             int i = f.st.node[27 * k + s];
             if (i < 0) continue;
-            for (int d = 0; d < 3; ++d) ref[d] += f.st.w[27 * k + s] * vel[3 * i + d];
+            for (int d = 0; d < 3; ++d) ref[d] += wk[s] * vel[3 * i + d];
         }
         for (int d = 0; d < 3; ++d) {
             worst_v = fmax(worst_v, fabs(vh[d] - vn[d]));
