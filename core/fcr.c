@@ -45,11 +45,9 @@ double fcr_rest_stiffness(double mu, double lambda)
     return sqrt(3.0 * a * a + 6.0 * lambda * lambda + 12.0 * mu * mu);
 }
 
-/* Replaces the symmetric 3x3 matrix A by its projection onto the PSD cone
- * (eigenvalues clamped at 0, as HOT's makePD; HOT reference §1.7). Positive
- * definite input (Sylvester: leading principal minors > 0) is returned
- * unchanged; otherwise cyclic Jacobi eigendecomposition. */
-static void sym3_clamp_psd(double A[3][3])
+/* Positive definite input (Sylvester: leading principal minors > 0) is
+ * returned unchanged; otherwise cyclic Jacobi eigendecomposition. */
+void fcr_sym3_clamp_psd(double A[3][3])
 {
     double m2 = A[0][0] * A[1][1] - A[0][1] * A[0][1];
     double det = A[0][0] * (A[1][1] * A[2][2] - A[1][2] * A[1][2]) -
@@ -143,7 +141,7 @@ void fcr_dPdF(const double F[9], double mu, double lambda, int projected, double
     }
 
     if (projected) {
-        sym3_clamp_psd(Ah);
+        fcr_sym3_clamp_psd(Ah);
         for (int e = 0; e < 3; ++e) {
             if (mc[e] < 0.0) mc[e] = 0.0;
             if (pc[e] < 0.0) pc[e] = 0.0;

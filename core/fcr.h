@@ -24,6 +24,11 @@ double fcr_psi_P(const double F[9], double mu, double lambda, double P[9]);
 /* dP/dF at F, projected to SPD when `projected` is non-zero. */
 void fcr_dPdF(const double F[9], double mu, double lambda, int projected, double A[81]);
 
+/* Replaces the symmetric 3x3 matrix A by its projection onto the PSD cone
+ * (eigenvalues clamped at 0, as HOT's makePD; HOT reference §1.7): the
+ * projected dP/dF's step on d2psi/dsigma2, shared with fcr_dPdF4. */
+void fcr_sym3_clamp_psd(double A[3][3]);
+
 /* ||dP/dF (F = I)||_F over the full 9x9: sqrt(3(2mu+lambda)^2 + 6 lambda^2 + 12 mu^2)
  * (SPEC 4, the characteristic-norm stiffness a_p). */
 double fcr_rest_stiffness(double mu, double lambda);

@@ -9,6 +9,7 @@
 #include <math.h>
 
 #include "core/fcr.h"
+#include "core/fcr4_lanes.h"
 #include "core/svd3.h"
 
 static void fcr4_portable(const double *F, const double *mu, const double *lambda, double *P, double psi[4])
@@ -16,39 +17,19 @@ static void fcr4_portable(const double *F, const double *mu, const double *lambd
     for (int l = 0; l < 4; ++l) psi[l] = fcr_psi_P(F + 9 * l, mu[l], lambda[l], P + 9 * l);
 }
 
-/* svd3 takes its ordinary path for F (no scaling, no special case). */
-static int usual(const double *F)
+/* NaN is tested first, so a compare replaces fmax (a libm call here). */
+int fcr4_usual(const double *F)
 {
     double m = 0.0;
     for (int k = 0; k < 9; ++k) {
-        if (isnan(F[k])) return 0;
-        m = fmax(m, fabs(F[k]));
+        double a = fabs(F[k]);
+        if (isnan(a)) return 0;
+        if (a > m) m = a;
     }
     return m >= 0x1p-128 && m <= 0x1p128;
 }
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#include <immintrin.h>
-#define HAVE_AVX_CLONE 1
-
-typedef __m256d V;
-#define AVX __attribute__((target("avx")))
-#define AVXI static inline __attribute__((target("avx"), always_inline))
-
-
-AVXI V add(V a, V b) { return _mm256_add_pd(a, b); }
-AVXI V sub(V a, V b) { return _mm256_sub_pd(a, b); }
-AVXI V mul(V a, V b) { return _mm256_mul_pd(a, b); }
-AVXI V dvd(V a, V b) { return _mm256_div_pd(a, b); }
-AVXI V sqr(V a) { return _mm256_sqrt_pd(a); }
-AVXI V cst(double x) { return _mm256_set1_pd(x); }
-/* m ? a : b per lane */
-AVXI V sel(V m, V a, V b) { return _mm256_blendv_pd(b, a, m); }
-AVXI V neg(V a) { return _mm256_xor_pd(a, cst(-0.0)); }
-AVXI V vabs(V a) { return _mm256_andnot_pd(cst(-0.0), a); }
-/* copysign(x, y) */
-AVXI V csign(V x, V y) { return _mm256_or_pd(vabs(x), _mm256_and_pd(cst(-0.0), y)); }
-AVXI V dot3(const V x[3], const V y[3]) { return add(add(mul(x[0], y[0]), mul(x[1], y[1])), mul(x[2], y[2])); }
+#ifdef HAVE_AVX_CLONE
 
 /* svd3.c jacobi_pair on the lanes that need a rotation; returns them as bits. */
 AVXI int jacobi4(V ci[3], V cj[3], V vi[3], V vj[3])
@@ -89,13 +70,10 @@ AVXI void swap4(V c[3][3], V v[3][3], V n2[3], int i, int j, V m)
     n2[j] = sel(m, t, n2[j]);
 }
 
-/* Returns the lanes (bits) that need svd3's rank-deficient branch. */
-AVX static int fcr4_avx(const double *F, const double *mu, const double *lambda, double *P, double psi[4])
+AVX int fcr4_svd_avx(const V f[9], V u[3][3], V v[3][3], V sg[3])
 {
-    V f[9];
-    for (int e = 0; e < 9; ++e) f[e] = _mm256_setr_pd(F[e], F[9 + e], F[18 + e], F[27 + e]);
     /* c[k] = column k of F, v[k] = column k of V */
-    V c[3][3], v[3][3];
+    V c[3][3];
     for (int k = 0; k < 3; ++k)
         for (int r = 0; r < 3; ++r) {
             c[k][r] = f[3 * r + k];
@@ -113,7 +91,6 @@ AVX static int fcr4_avx(const double *F, const double *mu, const double *lambda,
     swap4(c, v, n2, 1, 2, _mm256_cmp_pd(n2[1], n2[2], _CMP_LT_OQ));
     swap4(c, v, n2, 0, 1, _mm256_cmp_pd(n2[0], n2[1], _CMP_LT_OQ));
 
-    V u[3][3];
     V s0 = sqr(n2[0]);
     for (int k = 0; k < 3; ++k) u[0][k] = dvd(c[0][k], s0);
     V d = dot3(u[0], c[1]);
@@ -127,7 +104,19 @@ AVX static int fcr4_avx(const double *F, const double *mu, const double *lambda,
     u[2][1] = sub(mul(u[0][2], u[1][0]), mul(u[0][0], u[1][2]));
     u[2][2] = sub(mul(u[0][0], u[1][1]), mul(u[0][1], u[1][0]));
     V proj = dot3(u[2], c[2]);
-    V sg[3] = {s0, sqr(n2[1]), csign(sqr(n2[2]), proj)};
+    sg[0] = s0;
+    sg[1] = sqr(n2[1]);
+    sg[2] = csign(sqr(n2[2]), proj);
+    return rank1;
+}
+
+/* Returns the lanes (bits) that need svd3's rank-deficient branch. */
+AVX static int fcr4_avx(const double *F, const double *mu, const double *lambda, double *P, double psi[4])
+{
+    V f[9];
+    for (int e = 0; e < 9; ++e) f[e] = _mm256_setr_pd(F[e], F[9 + e], F[18 + e], F[27 + e]);
+    V u[3][3], v[3][3], sg[3];
+    int rank1 = fcr4_svd_avx(f, u, v, sg);
 
     /* fcr_psi_P: R = U V^T (U[3r+k] = u[k][r], V likewise), cof F, P, psi */
     V one = cst(1.0);
@@ -159,17 +148,15 @@ AVX static int fcr4_avx(const double *F, const double *mu, const double *lambda,
     _mm256_storeu_pd(psi, e);
     return rank1;
 }
-
-static int cpu_has_avx(void) { return __builtin_cpu_supports("avx"); }
 #endif
 
 void fcr_psi_P4(const double *F, const double *mu, const double *lambda, double *P, double psi[4], int kernel)
 {
 #ifdef HAVE_AVX_CLONE
-    if (kernel == FCR4_AUTO && cpu_has_avx()) {
+    if (kernel == FCR4_AUTO && fcr4_cpu_has_avx()) {
         int redo = fcr4_avx(F, mu, lambda, P, psi);
         for (int l = 0; l < 4; ++l)
-            if (((redo >> l) & 1) || !usual(F + 9 * l)) psi[l] = fcr_psi_P(F + 9 * l, mu[l], lambda[l], P + 9 * l);
+            if (((redo >> l) & 1) || !fcr4_usual(F + 9 * l)) psi[l] = fcr_psi_P(F + 9 * l, mu[l], lambda[l], P + 9 * l);
         return;
     }
 #endif
@@ -179,7 +166,7 @@ void fcr_psi_P4(const double *F, const double *mu, const double *lambda, double 
 const char *fcr4_isa(void)
 {
 #ifdef HAVE_AVX_CLONE
-    if (cpu_has_avx()) return "avx";
+    if (fcr4_cpu_has_avx()) return "avx";
 #endif
     return "portable";
 }

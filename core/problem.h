@@ -68,7 +68,7 @@ typedef struct StepProblem {
     size_t cap_A;
     int tangent_projected;
     int tangent_stored;  /* A holds the tangent at the cached F (problem_tangent since the last energy) */
-    int stress_kernel;   /* FCR4_AUTO (0) or _PORTABLE: the energy's psi and P kernel (core/fcr4.h) */
+    int stress_kernel;   /* FCR4_AUTO (0) or _PORTABLE: the kernel of the energy (psi, P) and of the tangent (core/fcr4.h) */
     int gradient_kernel; /* GRADIENT_CELL_AUTO (0) or _PORTABLE: the gradient's cell kernel (core/gradient_cell.h) */
     int cell_kernel;     /* HESSIAN_CELL_AUTO (0) or _PORTABLE: the assembly's cell kernel (core/hessian_cell.h) */
     double elastic_energy;

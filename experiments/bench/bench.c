@@ -44,6 +44,13 @@ static void run_assemble(void *ctx)
     problem_assemble(&b->sim->pb, b->H);
 }
 
+/* The projected tangent dP/dF of every particle at the cached F (SPEC 3). */
+static void run_tangent(void *ctx)
+{
+    BenchCtx *b = ctx;
+    problem_tangent(&b->sim->pb, 1);
+}
+
 /* One line-search trial: F(dv), SVD, psi and P per particle (SPEC 3). */
 static void run_energy(void *ctx)
 {
@@ -160,6 +167,20 @@ static KernelModel model_energy(double nodes_per_particle, double tests, double 
     KernelModel m = {"energy (F, SVD, psi, P)", 0, 0};
     m.flops = 648.0 + 18.0 + 18.0 * tests + 51.0 * rotations + 55.0 + 127.0 + 2.0 + 15.0 * nodes_per_particle;
     m.bytes = 648.0 + 72.0 + 108.0 + 24.0 + 144.0 + 48.0 * nodes_per_particle;
+    return m;
+}
+
+/* Tangent (problem_tangent, projected), counted from core/fcr.c: the SVD as
+ * in the energy (same sweep counts); J, S_k, lambda (J-1), psihat_k 19;
+ * Ahat 24; m and p 18; the basis products M^kk 27 and Ahat M 135; the twist
+ * and flip vectors 168; the rank-9 sum over the upper triangle 45 x 18 = 810
+ * (the projection's eigen-solve runs only where Ahat is indefinite: not
+ * counted). Bytes: F 72, mu, lambda 16, A written 648. */
+static KernelModel model_tangent(double tests, double rotations)
+{
+    KernelModel m = {"tangent (SVD, dP/dF)", 0, 0};
+    m.flops = 18.0 + 18.0 * tests + 51.0 * rotations + 55.0 + 19.0 + 24.0 + 18.0 + 27.0 + 135.0 + 168.0 + 810.0;
+    m.bytes = 72.0 + 16.0 + 648.0;
     return m;
 }
 
@@ -285,6 +306,11 @@ int bench_run(const char *what, const RunConfig *cfg)
         double t2 = machine_best_time(run_scatter, &bc, min_s, NULL);
         printf("%-28s %10.3f ms %10.3g p/s\nscatter_particles_per_s=%.4g\n", "assemble (scatter only)", 1e3 * t2,
                np / t2, np / t2);
+    }
+    if (all || !strcmp(what, "tangent")) {
+        double t = machine_best_time(run_tangent, &bc, min_s, &spread);
+        report(&L, model_tangent(ENERGY_SVD_TESTS, ENERGY_SVD_ROTATIONS), t, spread, "tangent");
+        printf("tangent_kernel_isa=%s\n", fcr4_isa());
     }
     if (all || !strcmp(what, "energy")) {
         /* a trial point off the initial guess, as a line search's: dv0 + 1e-3 x */

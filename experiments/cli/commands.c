@@ -76,7 +76,7 @@ static const Command run_command = {
 
 /* ------------------------------------------------------------------ bench */
 
-static const char *const bench_what[] = {"spmv", "assemble", "hessvec", "energy", "gradient", "p2g", "g2p", "all", NULL};
+static const char *const bench_what[] = {"spmv", "assemble", "tangent", "hessvec", "energy", "gradient", "p2g", "g2p", "all", NULL};
 static const char *const bench_transfers[] = {"apic", "mls", NULL};
 
 typedef struct {
@@ -116,9 +116,9 @@ static int bench_cmd(void *args, const char *what, int *exit_code)
 
 static const Command bench_command = {
     .name = "bench",
-    .operand = "spmv|assemble|hessvec|energy|gradient|p2g|g2p|all",
+    .operand = "spmv|assemble|tangent|hessvec|energy|gradient|p2g|g2p|all",
     .operand_choices = bench_what,
-    .operand_missing = "spmv, assemble, hessvec, p2g, g2p or all",
+    .operand_missing = "spmv, assemble, tangent, hessvec, energy, gradient, p2g, g2p or all",
     .required = bench_required,
     .summary = "Kernel throughput on a scene's first time step against the machine's limits measured in the same "
                "process (STREAM triad, FMA peak): block-CSR SpMV, matrix-free H x, Hessian assembly, the P2G and G2P "

@@ -64,7 +64,8 @@ fi
 check "bench exit 0" test $? -eq 0
 for key in spmv_gbs stream_gbs spmv_stream_ratio assemble_particles_per_s p2g_particles_per_s threads \
   g2p_particles_per_s hessvec_particles_per_s p2g_stream_fraction p2g_peak_fraction g2p_flops_per_particle \
-  stream_dram_gbs peak_gflops energy_particles_per_s energy_peak_fraction gradient_particles_per_s; do
+  stream_dram_gbs peak_gflops energy_particles_per_s energy_peak_fraction gradient_particles_per_s \
+  tangent_particles_per_s; do
   check "bench reports $key > 0" awk -F= -v k="$key" '$1 == k && $2 + 0 > 0 {found = 1} END {exit !found}' "$tmp/bench.out"
 done
 check "bench: particles of drop" grep -qx "particles=6938" "$tmp/bench.out"

@@ -2,9 +2,12 @@
  * four particles in SIMD lanes, core/fcr4.h) and problem_gradient (by cells,
  * core/gradient_cell.h), for every variant the dispatch can choose (AUTO:
  * AVX, AVX2+FMA where the CPU has them; PORTABLE):
- *  - fcr_psi_P4 against fcr_psi_P lane by lane, bit for bit (same operations
- *    in the same order, no FMA), on near-identity, large, inverted,
- *    rank-deficient, zero, huge, tiny and NaN inputs;
+ *  - fcr_psi_P4 against fcr_psi_P and fcr_dPdF4 against fcr_dPdF (plain
+ *    and projected) lane by lane, bit for bit (same operations in the same
+ *    order, no FMA), on near-identity, large, inverted, rank-deficient,
+ *    zero, huge, tiny and NaN inputs and near-degenerate singular values;
+ *  - problem_tangent (fcr_dPdF4 by four, the rest alone) against fcr_dPdF
+ *    per particle, bit for bit, on the scenes below;
  *  - on a scene's first step (bar3) and on the two-material fixture (with
  *    inverted particles and Dirichlet nodes, B-spline and MLS gradients, and
  *    with zero-weight stencil nodes that differ within a cell),
@@ -66,6 +69,23 @@ static void check_lanes(const double F[36], const double mu[4], const double la[
         }
     }
     CHECK(bad == 0, "%s (kernel %d): fcr_psi_P4 differs from fcr_psi_P", what, kernel);
+    /* the tangent, plain and projected */
+    for (int proj = 0; proj <= 1; ++proj) {
+        double A[4 * 81], Ar[81];
+        fcr_dPdF4(F, mu, la, proj, A, kernel);
+        int tbad = 0;
+        for (int l = 0; l < 4 && !tbad; ++l) {
+            fcr_dPdF(F + 9 * l, mu[l], la[l], proj, Ar);
+            for (int e = 0; e < 81; ++e)
+                if (!same_bits(Ar[e], A[81 * l + e])) {
+                    printf("%s kernel=%d projected=%d lane %d: A[%d] %.17g vs %.17g\n", what, kernel, proj, l, e,
+                           A[81 * l + e], Ar[e]);
+                    tbad = 1;
+                    break;
+                }
+        }
+        CHECK(tbad == 0, "%s (kernel %d, projected %d): fcr_dPdF4 differs from fcr_dPdF", what, kernel, proj);
+    }
 }
 
 static void test_lanes(int kernel)
@@ -103,6 +123,21 @@ static void test_lanes(int kernel)
                 for (int e = 0; e < 9; ++e) G[27 + e] = (e % 4 == 0) ? 1.0 : 0.0; /* identity */
                 for (int e = 0; e < 9; ++e) G[e] = (e == 0 || e == 4) ? 1.5 : 0.0; /* rank two */
                 check_lanes(G, mu, la, kernel, "identity, rank two");
+                /* near-degenerate singular values, rotated by the other lanes'
+                 * F (not orthogonal: a well-conditioned mix), and a pair
+                 * sigma_1 + sigma_2 below the tangent's 1e-6 clamp */
+                static const double sv[4][3] = {
+                    {1.0, 1.0 + 1e-12, 1.0 - 1e-12}, {2.0, 2.0, -2.0}, {1.5, 1.5 * (1 + 1e-9), 0.3}, {2.0, 3e-7, -2.5e-7}};
+                memcpy(G, F, sizeof G);
+                for (int l = 0; l < 4; ++l) {
+                    const double *M = F + 9 * ((l + 1) % 4);
+                    for (int r = 0; r < 3; ++r)
+                        for (int c = 0; c < 3; ++c) G[9 * l + 3 * r + c] = M[3 * r + c] * sv[l][c];
+                }
+                check_lanes(G, mu, la, kernel, "near-degenerate, mixed");
+                for (int l = 0; l < 4; ++l)
+                    for (int e = 0; e < 9; ++e) G[9 * l + e] = e % 4 == 0 ? sv[l][e / 4] : 0.0;
+                check_lanes(G, mu, la, kernel, "near-degenerate, diagonal");
             }
         }
 }
@@ -224,6 +259,20 @@ static void check_problem(StepProblem *pb, const char *what)
         CHECK(eerr <= 1e-13, "%s kernel %d: energy %.17g vs reference %.17g (%.2e of sum|terms|)", what, kernel, E,
               R.E, eerr);
         CHECK(gerr <= 1e-13, "%s kernel %d: gradient error %.2e of sum|terms|", what, kernel, gerr);
+        /* the tangent at the cached F: fcr_dPdF's bits for every particle
+         * (four in lanes, the last n mod 4 alone) */
+        for (int proj = 0; proj <= 1; ++proj) {
+            problem_tangent(pb, proj);
+            long abad = 0;
+            double Ar[81];
+            for (size_t k = 0; k < np; ++k) {
+                fcr_dPdF(pb->F + 9 * k, pb->mu[k], pb->lambda[k], proj, Ar);
+                for (int e = 0; e < 81; ++e) abad += !same_bits(pb->A[81 * k + e], Ar[e]);
+            }
+            printf("%s kernel %d: tangent (projected %d) differs from fcr_dPdF in %ld entries\n", what, kernel,
+                   proj, abad);
+            CHECK(abad == 0, "%s kernel %d: tangent (projected %d) differs in %ld entries", what, kernel, proj, abad);
+        }
     }
     pb->stress_kernel = FCR4_AUTO;
     pb->gradient_kernel = GRADIENT_CELL_AUTO;
