@@ -176,31 +176,41 @@ void transfer_g2p_opts(const Grid *g, const Stencils *st, Particles *p, const do
         double *xp = p->x + 3 * k;
         const int *base = st->base + 3 * k;
         const int *node = st->node + MPM_STENCIL * k;
-        double w[MPM_STENCIL], dw[3 * MPM_STENCIL];
-        stencil_weights(st, k, w, dw);
+        /* the weights and gradients as stencil_weights builds them (the same
+         * products, so the same bits), formed slot by slot in registers */
+        const double *N = st->f1d + 18 * k, *D = N + 9;
         double v[3] = {0, 0, 0}, B[9] = {0}, G[9] = {0}, dvw[3] = {0, 0, 0};
-        for (int s = 0; s < MPM_STENCIL; ++s) {
-            int i = node[s];
-            if (i < 0) continue;
-            const double *vi = vnew + 3 * (size_t)i;
-            double r[3] = {(base[0] + s / 9) * dx - xp[0], (base[1] + (s / 3) % 3) * dx - xp[1],
-                           (base[2] + s % 3) * dx - xp[2]};
-            if (mls) /* no weight gradient: C'_p = 4/dx^2 B_p is the velocity gradient */
-                for (int a = 0; a < 3; ++a) {
-                    double wv = w[s] * vi[a];
-                    v[a] += wv;
-                    for (int b = 0; b < 3; ++b) B[3 * a + b] += wv * r[b];
-                }
-            else
-                for (int a = 0; a < 3; ++a) {
-                    v[a] += w[s] * vi[a];
-                    for (int b = 0; b < 3; ++b) {
-                        B[3 * a + b] += w[s] * vi[a] * r[b];
-                        G[3 * a + b] += vi[a] * dw[3 * s + b];
+        for (int oa = 0, s = 0; oa < 3; ++oa) {
+            const double r0 = (base[0] + oa) * dx - xp[0];
+            for (int ob = 0; ob < 3; ++ob) {
+                const double r1 = (base[1] + ob) * dx - xp[1];
+                const double nn = N[oa] * N[3 + ob], dn = D[oa] * N[3 + ob], nd = N[oa] * D[3 + ob];
+                for (int oc = 0; oc < 3; ++oc, ++s) {
+                    int i = node[s];
+                    if (i < 0) continue;
+                    const double *vi = vnew + 3 * (size_t)i;
+                    const double r[3] = {r0, r1, (base[2] + oc) * dx - xp[2]};
+                    const double ws = nn * N[6 + oc];
+                    if (mls) /* no weight gradient: C'_p = 4/dx^2 B_p is the velocity gradient */
+                        for (int a = 0; a < 3; ++a) {
+                            double wv = ws * vi[a];
+                            v[a] += wv;
+                            for (int b = 0; b < 3; ++b) B[3 * a + b] += wv * r[b];
+                        }
+                    else {
+                        const double dws[3] = {dn * N[6 + oc], nd * N[6 + oc], nn * D[6 + oc]};
+                        for (int a = 0; a < 3; ++a) {
+                            v[a] += ws * vi[a];
+                            for (int b = 0; b < 3; ++b) {
+                                B[3 * a + b] += ws * vi[a] * r[b];
+                                G[3 * a + b] += vi[a] * dws[b];
+                            }
+                        }
                     }
+                    if (pic_flip)
+                        for (int a = 0; a < 3; ++a) dvw[a] += ws * (vi[a] - vold[3 * (size_t)i + a]);
                 }
-            if (pic_flip)
-                for (int a = 0; a < 3; ++a) dvw[a] += w[s] * (vi[a] - vold[3 * (size_t)i + a]);
+            }
         }
         double *C = p->C + 9 * k;
         if (pic_flip) {
