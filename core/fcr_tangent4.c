@@ -35,13 +35,13 @@ AVX static void clamp_lanes(V Ah[3][3])
     V zero = _mm256_setzero_pd();
     V pd = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(Ah[0][0], zero, _CMP_GT_OQ), _mm256_cmp_pd(m2, zero, _CMP_GT_OQ)),
                          _mm256_cmp_pd(det, zero, _CMP_GT_OQ));
-    int todo = ~_mm256_movemask_pd(pd) & 15;
-    if (!todo) return;
+    int pending = ~_mm256_movemask_pd(pd) & 15;
+    if (!pending) return;
     Lanes a[3][3];
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) a[i][j].v = Ah[i][j];
     for (int l = 0; l < 4; ++l) {
-        if (!((todo >> l) & 1)) continue;
+        if (!((pending >> l) & 1)) continue;
         double s[3][3];
         for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j) s[i][j] = a[i][j].d[l];
