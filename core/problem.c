@@ -342,18 +342,24 @@ double *problem_tangent_storage(StepProblem *pb)
     return pb->A;
 }
 
-/* Four particles at a time share the SIMD lanes of the SVD and of the rank-9
- * sum (core/fcr4.h; the scalar fcr_dPdF's bits), the last n mod 4 alone. */
+/* The tangent of particles [k0, k1) into A (81 numbers each): four at a
+ * time in the SIMD lanes of the SVD and of the rank-9 sum (core/fcr4.h;
+ * the scalar fcr_dPdF's bits), the last (k1 - k0) mod 4 alone. */
+static void tangent_range(const StepProblem *pb, int projected, size_t k0, size_t k1, double *A)
+{
+    size_t k = k0;
+    for (; k + 4 <= k1; k += 4)
+        fcr_dPdF4(pb->F + 9 * k, pb->mu + k, pb->lambda + k, projected, A + 81 * (k - k0), pb->stress_kernel);
+    for (; k < k1; ++k) fcr_dPdF(pb->F + 9 * k, pb->mu[k], pb->lambda[k], projected, A + 81 * (k - k0));
+}
+
 int problem_tangent(StepProblem *pb, int projected)
 {
-    const Particles *p = pb->parts;
+    const size_t n = pb->parts->n;
     if (!problem_tangent_storage(pb)) return MPM_EINTERNAL;
-    size_t n4 = p->n / 4;
 #pragma omp parallel for schedule(static)
-    for (size_t q = 0; q < n4; ++q)
-        fcr_dPdF4(pb->F + 36 * q, pb->mu + 4 * q, pb->lambda + 4 * q, projected, pb->A + 324 * q, pb->stress_kernel);
-    for (size_t k = 4 * n4; k < p->n; ++k)
-        fcr_dPdF(pb->F + 9 * k, pb->mu[k], pb->lambda[k], projected, pb->A + 81 * k);
+    for (size_t k0 = 0; k0 < n; k0 += 4) /* groups of four; the last may be shorter */
+        tangent_range(pb, projected, k0, k0 + 4 < n ? k0 + 4 : n, pb->A + 81 * k0);
     pb->tangent_projected = projected;
     pb->tangent_stored = 1;
     return MPM_OK;
@@ -620,16 +626,6 @@ static void finish_row(const StepProblem *pb, Bsr *H, int i)
         for (int r = 0; r < 3; ++r)
             for (int c = 0; c < 3; ++c) Bt[3 * c + r] = B[3 * r + c];
     }
-}
-
-/* The tangent of particles [k0, k1) into A (81 numbers each), four at a
- * time in SIMD lanes as problem_tangent. */
-static void tangent_range(const StepProblem *pb, int projected, size_t k0, size_t k1, double *A)
-{
-    size_t k = k0;
-    for (; k + 4 <= k1; k += 4)
-        fcr_dPdF4(pb->F + 9 * k, pb->mu + k, pb->lambda + k, projected, A + 81 * (k - k0), pb->stress_kernel);
-    for (; k < k1; ++k) fcr_dPdF(pb->F + 9 * k, pb->mu[k], pb->lambda[k], projected, A + 81 * (k - k0));
 }
 
 /* The Hessian's blocks (i, j >= i) from the particles' tangents: pb->A

@@ -54,6 +54,20 @@ static inline void axpy9(double w, const double *restrict a, double *restrict ac
     for (int q = 0; q < 9; ++q) acc[q] += w * a[q];
 }
 
+/* Sparse accumulator: acc[slot of key] (+)= w a, the slot made on first use
+ * (pos: key -> slot or -1; list: the keys in slot order; *n slots used). */
+static inline void accumulate(int *pos, int *list, double *acc, int *n, int key, double w, const double *a)
+{
+    int p = pos[key];
+    if (p < 0) {
+        p = pos[key] = (*n)++;
+        list[p] = key;
+        set9(w, a, acc + 9 * (size_t)p);
+    } else {
+        axpy9(w, a, acc + 9 * (size_t)p);
+    }
+}
+
 typedef struct {
     int *fpos, *flist;
     double *facc;
@@ -175,18 +189,8 @@ static inline __attribute__((always_inline)) void rows_body(const Bsr *A, const 
                 me->err = 1;
                 break;
             }
-            for (int64_t k = rp[i]; k < rp[i + 1]; ++k) {
-                const int j = acol[k];
-                int pos = me->fpos[j];
-                const double *a = aval + 9 * k;
-                if (pos < 0) {
-                    pos = me->fpos[j] = nfl;
-                    me->flist[nfl++] = j;
-                    set9(w, a, me->facc + 9 * (size_t)pos);
-                } else {
-                    axpy9(w, a, me->facc + 9 * (size_t)pos);
-                }
-            }
+            for (int64_t k = rp[i]; k < rp[i + 1]; ++k)
+                accumulate(me->fpos, me->flist, me->facc, &nfl, acol[k], w, aval + 9 * k);
         }
         if (me->err) break;
         /* stage 2: row I of A_c (columns J >= I) = B P */
@@ -199,19 +203,8 @@ static inline __attribute__((always_inline)) void rows_body(const Bsr *A, const 
                 me->err = 1;
                 break;
             }
-            for (int64_t e = T->p_ptr[j]; e < T->p_ptr[j + 1]; ++e) {
-                const int J = T->p_col[e];
-                if (J < I) continue;
-                const double w = T->p_w[e];
-                int pos = me->cpos[J];
-                if (pos < 0) {
-                    pos = me->cpos[J] = ncl;
-                    me->clist[ncl++] = J;
-                    set9(w, B, me->cacc + 9 * (size_t)pos);
-                } else {
-                    axpy9(w, B, me->cacc + 9 * (size_t)pos);
-                }
-            }
+            for (int64_t e = T->p_ptr[j]; e < T->p_ptr[j + 1]; ++e)
+                if (T->p_col[e] >= I) accumulate(me->cpos, me->clist, me->cacc, &ncl, T->p_col[e], T->p_w[e], B);
         }
         if (me->err) break;
         /* emit the row sorted by column */
