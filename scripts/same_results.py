@@ -5,12 +5,13 @@
 
 OLD_DIR and NEW_DIR are `matrix run --out` folders (or two single `run --out`
 folders). Cells are matched by id (the id is a hash of the cell's settings, so
-the same matrix file gives the same ids). For every matched cell, every row of
+the same matrix file gives the same ids); NEW_DIR may hold a subset of
+OLD_DIR's cells (a run with --only). For every cell of NEW_DIR, every row of
 steps.csv must agree on every column that is not a time: iterations, the
 residual, the status, t and dt (printed to 17 digits, so the step length, which
 the CFL rule takes from the particle velocities, checks the state bit for bit).
 Prints one line per differing cell and a summary; exit 0 when all agree, 1 when
-any differs or a cell is missing from NEW_DIR, 2 on bad arguments.
+any differs or a cell of NEW_DIR is not in OLD_DIR, 2 on bad arguments.
 """
 import csv
 import os
@@ -69,18 +70,16 @@ def main(argv):
             print("same_results.py: %s: no cells/ and no steps.csv" % name, file=sys.stderr)
             return 2
     differ = 0
-    for cid in sorted(old):
-        if cid not in new:
-            print("%s: missing from %s" % (cid, argv[2]))
+    for cid in sorted(new):
+        if cid not in old:
+            print("%s: not in %s" % (cid, argv[1]))
             differ += 1
             continue
         why = compare(old[cid], new[cid])
         if why:
             print("%s: %s" % (cid, why))
             differ += 1
-    same = len(old) - differ
-    print("%d of %d cells give the same results%s" % (same, len(old),
-          "" if len(new) == len(old) else " (%d cells in %s)" % (len(new), argv[2])))
+    print("%d of %d cells give the same results (%d cells in %s)" % (len(new) - differ, len(new), len(old), argv[1]))
     return 1 if differ else 0
 
 
