@@ -10,8 +10,8 @@
 
 #include "core/error.h"
 #include "core/vec.h"
-#include "experiments/run/library_startup.h"
-#include "experiments/run/registry.h"
+#include "experiments/driver/library_startup.h"
+#include "experiments/driver/registry.h"
 
 struct ErrorRef {
     char spec[160];

@@ -19,7 +19,7 @@
  * saying which in steps.csv's ref_solver (a build without CHOLMOD takes
  * pn-pcg at every step). Against a reference that failed
  * the metrics are empty (ref_status failed). The reference solve and the metrics run inside
- * run_step's after-solve hook, whose time goes to no timing column (it is
+ * time_step_run's after-solve hook, whose time goes to no timing column (it is
  * ref_s); the problem's iterate cache is left at dv afterwards. */
 #ifndef MPM_ERROR_REF_H
 #define MPM_ERROR_REF_H
@@ -65,7 +65,7 @@ double error_ref_cholmod_bytes(int n_nodes);
 /* Whether that estimate is within ERROR_REF_MEMORY_FRACTION of the memory. */
 int error_ref_cholmod_fits(int n_nodes);
 
-/* run_step's after-solve hook (ctx = ErrorRef *): the reference solve of pb
+/* time_step_run's after-solve hook (ctx = ErrorRef *): the reference solve of pb
  * and the metrics for the solver's dv. Errors other than a numerical
  * breakdown of the reference (which is its ref_status) are returned. */
 int error_ref_measure(void *ctx, StepProblem *pb, const double *dv);

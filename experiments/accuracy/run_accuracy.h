@@ -10,7 +10,7 @@
 #include <stdio.h>
 
 #include "core/scene.h"
-#include "core/step.h"
+#include "experiments/driver/time_step.h"
 #include "experiments/accuracy/dt_replay.h"
 #include "experiments/accuracy/error_ref.h"
 #include "experiments/accuracy/trajectory.h"
@@ -46,10 +46,9 @@ int run_accuracy_open(RunAccuracy *a, const char *out_dir, const Scene *sc);
 /* run.json's "accuracy" object. */
 void *run_accuracy_json(const AccuracyConfig *c, const RunAccuracy *a);
 
-struct StepWork;
-/* Before each step: the replayed dt (sim->dt_next), run_step's after-solve
+/* Before each step: the replayed dt (sim->dt_next), time_step_run's after-solve
  * hook (the reference solve) in w, the last step's errors cleared. */
-int run_accuracy_before_step(RunAccuracy *a, Simulation *sim, int step_in_frame, struct StepWork *w);
+int run_accuracy_before_step(RunAccuracy *a, Simulation *sim, int step_in_frame, StepWork *w);
 
 /* The steps.csv columns before `reason` (header, and one step's fields,
  * each followed by a comma), the frames.csv ones likewise. */

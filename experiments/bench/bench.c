@@ -223,19 +223,22 @@ static void report(const Limits *L, KernelModel m, double t, double spread, cons
 
 int bench_run(const char *what, const RunConfig *cfg)
 {
-    int status;
-    if (cfg->threads > 0) omp_set_num_threads(cfg->threads);
-    int threads = omp_get_max_threads();
-    Scene scene;
-    if ((status = run_scene_load(cfg, &scene))) return status;
-    Simulation sim;
+    const char *solver_opts[RUN_MAX_LIST + 1];
+    SessionConfig sc;
+    run_session_config(cfg, &sc, solver_opts);
+    sc.solver = NULL; /* the kernels, not a solver */
+    Session ses;
+    int status = session_open(&sc, &ses);
+    if (status) return status;
+    const int threads = ses.threads;
+    const Scene *scene = &ses.scene;
+    Simulation *sim = &ses.sim;
     Bsr H = {0};
     BenchCtx bc = {0};
-    if ((status = sim_init(&sim, &scene))) goto done;
-    if ((status = step_begin(&sim))) goto done;
-    StepProblem *pb = &sim.pb;
+    if ((status = step_begin(sim))) goto done;
+    StepProblem *pb = &sim->pb;
     int n = pb->n_nodes;
-    size_t np = sim.p.n;
+    size_t np = sim->p.n;
     double *dv = bc.dv = malloc(sizeof(double) * 3 * (size_t)n);
     bc.grad = malloc(sizeof(double) * 3 * (size_t)n);
     bc.x = malloc(sizeof(double) * 3 * (size_t)n);
@@ -250,20 +253,20 @@ int bench_run(const char *what, const RunConfig *cfg)
     problem_tangent(pb, 1);
     if ((status = problem_assemble(pb, &H))) goto done;
     for (int i = 0; i < 3 * n; ++i) bc.x[i] = 1.0 + 1e-3 * (i % 17);
-    for (int i = 0; i < 3 * n; ++i) bc.vnew[i] = sim.grid.v[i] + 1e-3 * ((i % 7) - 3);
-    bc.sim = &sim;
+    for (int i = 0; i < 3 * n; ++i) bc.vnew[i] = sim->grid.v[i] + 1e-3 * ((i % 7) - 3);
+    bc.sim = sim;
     bc.H = &H;
-    bc.force.dt = sim.dt;
-    bc.force.mats = scene.materials;
-    memcpy(bc.force.gravity, scene.gravity, sizeof bc.force.gravity);
-    bc.g2p = (G2POptions){.kind = scene.transfer, .apic_ratio = scene.apic_ratio, .flip_alpha = scene.flip_alpha,
+    bc.force.dt = sim->dt;
+    bc.force.mats = scene->materials;
+    memcpy(bc.force.gravity, scene->gravity, sizeof bc.force.gravity);
+    bc.g2p = (G2POptions){.kind = scene->transfer, .apic_ratio = scene->apic_ratio, .flip_alpha = scene->flip_alpha,
                           .advect = 1};
     int all = !strcmp(what, "all");
     double min_s = 1.0;
-    const char *tname = scene.transfer == TRANSFER_MLS ? "mls" : scene.transfer == TRANSFER_APIC ? "apic" : "pic_flip";
+    const char *tname = scene->transfer == TRANSFER_MLS ? "mls" : scene->transfer == TRANSFER_APIC ? "apic" : "pic_flip";
 
     printf("bench on %s (transfer %s): %zu particles, %d active nodes, %lld blocks (%.1f per row), %d threads\n",
-           scene.name, tname, np, n, (long long)H.nnzb, (double)H.nnzb / n, threads);
+           scene->name, tname, np, n, (long long)H.nnzb, (double)H.nnzb / n, threads);
     size_t mat_bytes = bsr_bytes(&H);
     printf("  Hessian storage: %.1f MB, %.0f bytes per active node\n", mat_bytes / 1e6, (double)mat_bytes / n);
 
@@ -329,22 +332,22 @@ int bench_run(const char *what, const RunConfig *cfg)
         double t = machine_best_time(run_gradient, &bc, min_s, &spread);
         size_t cells = np > 0; /* runs of one base node */
         for (size_t k = 1; k < np; ++k)
-            cells += memcmp(sim.st.base + 3 * k, sim.st.base + 3 * (k - 1), 3 * sizeof(int)) != 0;
+            cells += memcmp(sim->st.base + 3 * k, sim->st.base + 3 * (k - 1), 3 * sizeof(int)) != 0;
         report(&L, model_gradient(npp, cells ? (double)np / (double)cells : 1.0), t, spread, "gradient");
         printf("gradient_kernel_isa=%s\ngradient_particles_per_cell=%.2f\n", gradient_cell_isa(),
                cells ? (double)np / (double)cells : 0.0);
     }
     if (all || !strcmp(what, "p2g")) {
         double t = machine_best_time(run_p2g, &bc, min_s, &spread);
-        report(&L, model_p2g(scene.transfer == TRANSFER_MLS, npp), t, spread, "p2g");
-        KernelModel mb = model_p2g(scene.transfer == TRANSFER_MLS, npp);
-        mb.name = scene.transfer == TRANSFER_MLS ? "P2G blocked (MLS)" : "P2G blocked (APIC + force)";
+        report(&L, model_p2g(scene->transfer == TRANSFER_MLS, npp), t, spread, "p2g");
+        KernelModel mb = model_p2g(scene->transfer == TRANSFER_MLS, npp);
+        mb.name = scene->transfer == TRANSFER_MLS ? "P2G blocked (MLS)" : "P2G blocked (APIC + force)";
         t = machine_best_time(run_p2g_blocked, &bc, min_s, &spread);
         report(&L, mb, t, spread, "p2g_blocked");
     }
     if (all || !strcmp(what, "g2p")) {
         double t = machine_best_time(run_g2p, &bc, min_s, &spread);
-        report(&L, model_g2p(scene.transfer == TRANSFER_MLS, npp), t, spread, "g2p");
+        report(&L, model_g2p(scene->transfer == TRANSFER_MLS, npp), t, spread, "g2p");
     }
     printf("particles=%zu\nactive_nodes=%d\nhessian_blocks=%lld\nhessian_bytes_per_node=%.1f\n", np, n,
            (long long)H.nnzb, (double)mat_bytes / n);
@@ -357,7 +360,6 @@ done:
     free(bc.y);
     free(bc.vnew);
     bsr_free(&H);
-    sim_free(&sim);
-    scene_free(&scene);
+    session_close(&ses);
     return status;
 }

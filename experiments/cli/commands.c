@@ -14,7 +14,7 @@
 #include "experiments/matrix/matrix_cmd.h"
 #include "experiments/render/render_cmd.h"
 #include "experiments/run/provenance.h"
-#include "experiments/run/registry.h"
+#include "experiments/driver/registry.h"
 #include "experiments/run/run.h"
 
 /* ------------------------------------------------------------------ list */

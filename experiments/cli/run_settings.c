@@ -7,21 +7,12 @@
 #include "core/error.h"
 #include "core/threads.h"
 #include "experiments/accuracy/error_ref.h"
-#include "experiments/run/registry.h"
+#include "experiments/driver/registry.h"
 
 _Static_assert(RUN_MAX_LIST == OPT_LIST_MAX, "RunConfig lists hold OPT_LIST_MAX values");
 _Static_assert(sizeof(FailurePolicy) == sizeof(int), "on_failure is set as an int");
 
 static int check_solver(const char *spec) { return solver_spec_check(spec, NULL, 0); }
-
-/* --set PATH=VALUE: scene_load takes the path and the value apart */
-static int check_set(const char *text)
-{
-    const char *eq = strchr(text, '=');
-    if (!eq || eq == text) return mpm_error(MPM_EINPUT, "--set '%s': expected key=value", text);
-    if (strlen(text) >= RUN_SET_TEXT) return mpm_error(MPM_EINPUT, "--set '%s': too long", text);
-    return MPM_OK;
-}
 
 static const char *const on_failure_names[] = {"stop", "continue", NULL}; /* FailurePolicy order */
 
@@ -47,7 +38,7 @@ const Option run_settings[] = {
      NULL, OPT_IN_DEFAULTS | OPT_AXIS | OPT_ID_ALWAYS, "OpenMP threads (default: OMP_NUM_THREADS or every core)"},
     {"--frames", "frames", "N", OPT_INT, 1, 0, NULL, NULL, F(frames), 0, NULL, MATRIX_ALL | OPT_ID_ALWAYS,
      "frames to simulate (default: the scene's)"},
-    {"--set", "set", "PATH=VALUE", OPT_LIST, 0, 0, "key=value", NULL, F(set), F(n_set), check_set,
+    {"--set", "set", "PATH=VALUE", OPT_LIST, 0, 0, "key=value", NULL, F(set), F(n_set), session_check_override,
      MATRIX_ALL | OPT_ID_ALWAYS | OPT_KEY_JSON,
      "override a scene field by its JSON path, e.g. materials.middle.E=1e9 (repeatable)"},
     {"--solver-opt", "solver_opts", "KEY=VALUE", OPT_LIST, 0, 0, "key=value", NULL, F(solver_opts), F(n_solver_opts),

@@ -12,7 +12,7 @@
 #include "core/scene/json_read.h"
 #include "core/scene/scene_load.h"
 #include "experiments/accuracy/error_ref.h"
-#include "experiments/run/registry.h"
+#include "experiments/driver/registry.h"
 
 /* Column names of cells.csv a named axis may not take. */
 static const char *const g_reserved[] = {"id",          "scene",  "solver", "eps",      "scale",

@@ -7,7 +7,7 @@
 
 #include "core/error.h"
 #include "core/scene/scene_load.h"
-#include "experiments/run/registry.h"
+#include "experiments/driver/registry.h"
 #include "experiments/run/run.h"
 #include "solvers/solver.h"
 
@@ -80,8 +80,11 @@ static int check_scene(const Matrix *m, const MatrixCell *c)
     RunConfig cfg;
     int st = matrix_cell_config(m, c, "", &cfg, &texts);
     if (st) return st;
+    const char *solver_opts[RUN_MAX_LIST + 1];
+    SessionConfig scfg;
+    run_session_config(&cfg, &scfg, solver_opts);
     Scene sc;
-    st = run_scene_load(&cfg, &sc);
+    st = session_load_scene(&scfg, &sc);
     int frames = sc.frames;
     scene_free(&sc);
     char scale[32], prefix[2048];

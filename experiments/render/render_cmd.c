@@ -10,11 +10,9 @@
 
 #include "core/error.h"
 #include "core/threads.h"
-#include "core/step.h"
 #include "core/scene/scene_load.h"
 #include "experiments/cli/run_settings.h"
-#include "experiments/run/frame_driver.h"
-#include "experiments/run/registry.h"
+#include "experiments/driver/frame_driver.h"
 #include "experiments/render/render.h"
 #include "experiments/run/run.h"
 #include "solvers/solver.h"
@@ -311,50 +309,35 @@ static int render_run(void *args, const char *operand, int *exit_code)
 {
     (void)operand, (void)exit_code;
     const RenderArgs *a = args;
-    Solver *solver = NULL;
-    int status;
-    if ((status = solver_from_spec(a->run.solver, NULL, 0, &solver))) return status;
-    if (a->run.threads > 0) omp_set_num_threads(a->run.threads);
-
-    Scene scene;
-    if ((status = run_scene_load(&a->run, &scene))) {
-        solver_destroy(solver);
-        return status;
-    }
+    const char *solver_opts[RUN_MAX_LIST + 1];
+    SessionConfig sc;
+    run_session_config(&a->run, &sc, solver_opts);
+    Session ses;
+    int status = session_open(&sc, &ses);
+    if (status) return status;
     char path[1100];
     if (a->out) snprintf(path, sizeof path, "%s", a->out);
-    else snprintf(path, sizeof path, "%s.png", scene.name);
-
-    if (a->frame == 0) {
-        status = render_state(a, &scene, &scene.particles, 0.0, path);
-        solver_destroy(solver);
-        scene_free(&scene);
-        return status;
+    else snprintf(path, sizeof path, "%s.png", ses.scene.name);
+    if (a->frame > 0) {
+        /* the frames as `run` simulates them (no limits; a failed step ends the command) */
+        SolveSettings set;
+        solve_settings_default(&set);
+        FrameDriver driver = {.frames = a->frame, .progress = 1};
+        DriveTotals sum;
+        char why[300];
+        if ((status = frame_driver_run(&driver, &ses.sim, ses.solver, &set, &sum, why, sizeof why))) goto done;
+        if (sum.stopped) {
+            status = mpm_error(MPM_EINTERNAL, "%s", why);
+            goto done;
+        }
+        if (sum.worst_status != SOLVE_CONVERGED)
+            fprintf(stderr, "mpmbench: warning: some steps did not converge (worst status %s)\n",
+                    solve_status_name((SolveStatus)sum.worst_status));
     }
-
-    /* the frames as `run` simulates them (no limits; a failed step ends the command) */
-    Simulation sim;
-    memset(&sim, 0, sizeof sim);
-    SolveSettings set;
-    solve_settings_default(&set);
-    FrameDriver driver = {.frames = a->frame};
-    RunSummary sum;
-    memset(&sum, 0, sizeof sum);
-    char why[300];
-    if ((status = sim_init(&sim, &scene))) goto done;
-    if ((status = frame_driver_run(&driver, &sim, solver, &set, &sum, why, sizeof why))) goto done;
-    if (sum.stopped) {
-        status = mpm_error(MPM_EINTERNAL, "%s", why);
-        goto done;
-    }
-    if (sum.worst_status != SOLVE_CONVERGED)
-        fprintf(stderr, "mpmbench: warning: some steps did not converge (worst status %s)\n",
-                solve_status_name((SolveStatus)sum.worst_status));
-    status = render_state(a, &scene, &sim.p, sim.t, path);
+    /* frame 0: the scene's particles as sampled (the simulation's copy may be reordered) */
+    status = render_state(a, &ses.scene, a->frame > 0 ? &ses.sim.p : &ses.scene.particles, ses.sim.t, path);
 done:
-    sim_free(&sim);
-    solver_destroy(solver);
-    scene_free(&scene);
+    session_close(&ses);
     return status;
 }
 

@@ -13,50 +13,22 @@
 #include "core/step.h"
 #include "core/scene/scene_load.h"
 #include "experiments/run/csv_write.h"
-#include "experiments/run/frame_driver.h"
-#include "experiments/run/library_startup.h"
+#include "experiments/driver/library_startup.h"
 #include "experiments/run/paths.h"
 #include "experiments/run/ply.h"
 #include "experiments/run/vtk.h"
 #include "experiments/run/provenance.h"
-#include "experiments/run/registry.h"
+#include "experiments/driver/registry.h"
 #include "experiments/accuracy/run_accuracy.h"
 #include "solvers/solver.h"
 
-#define RUN_MAX_SOLVER_OPTS 70
+#define RUN_MAX_SOLVER_OPTS (RUN_MAX_LIST + 1) /* the user's, and linesearch=armijo for --armijo */
 
 void run_config_default(RunConfig *c)
 {
     memset(c, 0, sizeof *c);
     c->eps = 1e-7;
     c->scale = 1.0;
-}
-
-/* The --set texts as scene_load's path/value pairs (checked: key=value,
- * shorter than RUN_SET_TEXT). */
-static int split_overrides(const RunConfig *cfg, SceneOverride *ov, char (*text)[RUN_SET_TEXT])
-{
-    for (int i = 0; i < cfg->n_set; ++i) {
-        const char *eq = strchr(cfg->set[i], '=');
-        if (!eq || eq == cfg->set[i] || strlen(cfg->set[i]) >= RUN_SET_TEXT)
-            return mpm_error(MPM_EINPUT, "--set '%s': expected key=value", cfg->set[i]);
-        snprintf(text[i], RUN_SET_TEXT, "%s", cfg->set[i]);
-        text[i][eq - cfg->set[i]] = '\0';
-        ov[i].key = text[i];
-        ov[i].value = text[i] + (eq - cfg->set[i]) + 1;
-    }
-    return MPM_OK;
-}
-
-int run_scene_load(const RunConfig *cfg, Scene *scene)
-{
-    SceneOverride ov[RUN_MAX_LIST];
-    char text[RUN_MAX_LIST][RUN_SET_TEXT];
-    int st = split_overrides(cfg, ov, text);
-    if (st) return st;
-    SceneLoadOptions lo = {.scale = cfg->scale, .overrides = ov, .n_overrides = cfg->n_set,
-                           .asset_dir = cfg->asset_dir, .max_particles = cfg->max_particles};
-    return scene_load(cfg->scene, &lo, scene);
 }
 
 void run_solve_settings(const RunConfig *cfg, SolveSettings *set)
@@ -74,6 +46,14 @@ static int solver_option_list(const RunConfig *cfg, const char **list)
     if (cfg->armijo) list[n++] = "linesearch=armijo";
     for (int i = 0; i < cfg->n_solver_opts && n < RUN_MAX_SOLVER_OPTS; ++i) list[n++] = cfg->solver_opts[i];
     return n;
+}
+
+void run_session_config(const RunConfig *cfg, SessionConfig *sc, const char **list)
+{
+    int n = solver_option_list(cfg, list);
+    *sc = (SessionConfig){.scene = cfg->scene, .scale = cfg->scale, .set = cfg->set, .n_set = cfg->n_set,
+                          .asset_dir = cfg->asset_dir, .max_particles = cfg->max_particles, .solver = cfg->solver,
+                          .solver_opts = list, .n_solver_opts = n, .threads = cfg->threads};
 }
 
 static AccuracyConfig accuracy_config(const RunConfig *cfg)
@@ -99,7 +79,7 @@ int run_config_check(const RunConfig *cfg)
     if (cfg->max_linear < 0) return mpm_error(MPM_EINPUT, "--max-linear %d: expected >= 1", cfg->max_linear);
     if ((st = check_seconds("--max-step-seconds", cfg->max_step_s))) return st;
     if ((st = check_seconds("--max-run-seconds", cfg->max_run_s))) return st;
-    if (cfg->on_failure != RUN_STOP && cfg->on_failure != RUN_CONTINUE)
+    if (cfg->on_failure != FAILURE_STOP && cfg->on_failure != FAILURE_CONTINUE)
         return mpm_error(MPM_EINPUT, "on_failure %d: expected stop or continue", (int)cfg->on_failure);
     SolveSettings set;
     run_solve_settings(cfg, &set);
@@ -220,7 +200,7 @@ static void write_run_json(const char *dir, const RunConfig *cfg, const Scene *s
     }
     json_t *limits = json_pack("{s:i, s:i, s:f, s:f, s:s}", "max_outer", set->max_outer, "max_linear", set->max_linear,
                                "max_step_seconds", cfg->max_step_s, "max_run_seconds", cfg->max_run_s, "on_failure",
-                               cfg->on_failure == RUN_CONTINUE ? "continue" : "stop");
+                               cfg->on_failure == FAILURE_CONTINUE ? "continue" : "stop");
     json_t *root = json_pack("{s:s, s:s, s:s, s:s, s:s, s:o, s:o, s:f, s:f, s:f, s:i, s:i, s:s, s:o, s:I}", "scene",
                              sc->name, "scene_path", sc->path, "solver", cfg->solver, "outer_method",
                              solver->outer->ops->name, "inverse_approximation", solver->inv->ops->name,
@@ -246,110 +226,44 @@ static void write_run_json(const char *dir, const RunConfig *cfg, const Scene *s
     json_decref(root);
 }
 
-/* A numerical breakdown outside the solver: the step's failed status. */
-static int breakdown(int status, SolveStats *ss)
-{
-    if (status != MPM_ENUMERIC) return status;
-    ss->status = SOLVE_FAILED;
-    snprintf(ss->reason, sizeof ss->reason, "%s", mpm_last_error());
-    mpm_clear_error();
-    return MPM_OK;
-}
-
-int run_step(Simulation *sim, Solver *solver, const SolveSettings *set, StepWork *w, IterHook hook, void *hook_ctx,
-             int apply_failed, SolveStats *ss, StepInfo *info)
-{
-    int status;
-    memset(ss, 0, sizeof *ss);
-    memset(info, 0, sizeof *info);
-    double t0 = omp_get_wtime();
-    info->t = sim->t;
-    status = step_begin(sim);
-    double t1 = omp_get_wtime();
-    info->begin_s = t1 - t0;
-    info->dt = sim->dt;
-    if (status) {
-        info->wall_s = info->begin_s;
-        return breakdown(status, ss);
-    }
-    info->t = sim->t;
-    int n = sim->pb.n_nodes;
-    info->active_nodes = n;
-    if (n > w->cap) {
-        int cap = n + n / 4 + 256;
-        double *q = realloc(w->dv, sizeof(double) * 3 * (size_t)cap);
-        if (!q) return mpm_error(MPM_EINTERNAL, "out of memory: dv (%d nodes)", n);
-        w->dv = q;
-        w->cap = cap;
-    }
-    problem_initial_guess(&sim->pb, w->dv);
-    if ((status = solver_solve(solver, &sim->pb, set, w->dv, ss, hook, hook_ctx))) return status;
-    double t2 = omp_get_wtime();
-    if (ss->status != SOLVE_FAILED || apply_failed) {
-        if (w->after_solve) {
-            if ((status = w->after_solve(w->after_solve_ctx, &sim->pb, w->dv))) return status;
-            info->after_solve_s = omp_get_wtime() - t2;
-        }
-        SolveStats end = {0};
-        status = breakdown(step_end(sim, w->dv), &end);
-        if (status) return status;
-        if (end.status == SOLVE_FAILED) {
-            ss->status = SOLVE_FAILED;
-            snprintf(ss->reason, sizeof ss->reason, "%s", end.reason);
-        } else {
-            info->advanced = 1;
-        }
-    }
-    double t3 = omp_get_wtime();
-    info->wall_s = t3 - t0 - info->after_solve_s;
-    info->end_s = t3 - t2 - info->after_solve_s;
-    return MPM_OK;
-}
-
 int run_simulation(const RunConfig *cfg, RunSummary *sum)
 {
     int status = MPM_OK;
     memset(sum, 0, sizeof *sum);
-    /* every input checked before any work: the solver is created first */
+    /* every input checked before any work */
     if ((status = run_config_check(cfg))) return status;
     const char *solver_opts[RUN_MAX_SOLVER_OPTS];
-    int n_solver_opts = solver_option_list(cfg, solver_opts);
-    Solver *solver = NULL;
-    if ((status = solver_from_spec(cfg->solver, solver_opts, n_solver_opts, &solver))) return status;
+    SessionConfig scfg;
+    run_session_config(cfg, &scfg, solver_opts);
     SolveSettings set;
     run_solve_settings(cfg, &set);
-    if (cfg->threads > 0) omp_set_num_threads(cfg->threads);
-    int threads = omp_get_max_threads();
-    /* MPI, hypre, CHOLMOD, the thread team: started (and timed) here, not in the first step */
     AccuracyConfig acfg = accuracy_config(cfg);
     RunAccuracy acc;
     memset(&acc, 0, sizeof acc);
-    if ((status = library_startup(solver)) || (status = run_accuracy_create(&acfg, &acc))) {
+    /* the solver, the thread team, the libraries (started and timed here, not
+     * in the first step), the scene and the simulation */
+    Session ses;
+    if ((status = session_open(&scfg, &ses))) return status;
+    Solver *solver = ses.solver;
+    const Scene *scene = &ses.scene;
+    Simulation *sim = &ses.sim;
+    int threads = ses.threads;
+    if ((status = run_accuracy_create(&acfg, &acc))) {
         run_accuracy_free(&acc);
-        solver_destroy(solver);
+        session_close(&ses);
         return status;
     }
-
-    Scene scene;
-    if ((status = run_scene_load(cfg, &scene))) {
-        run_accuracy_free(&acc);
-        solver_destroy(solver);
-        return status;
-    }
-    int frames = cfg->frames > 0 ? cfg->frames : scene.frames;
+    int frames = cfg->frames > 0 ? cfg->frames : scene->frames;
     /* the reference runs match this scene: checked before the output folder is made */
-    if ((status = run_accuracy_bind(&acfg, &scene, frames, &acc))) {
+    if ((status = run_accuracy_bind(&acfg, scene, frames, &acc))) {
         run_accuracy_free(&acc);
-        solver_destroy(solver);
-        scene_free(&scene);
+        session_close(&ses);
         return status;
     }
 
     char out_dir[1024];
     if (cfg->out_dir) snprintf(out_dir, sizeof out_dir, "%s", cfg->out_dir);
-    else snprintf(out_dir, sizeof out_dir, "out/%s-%s", scene.name, solver->name);
-    Simulation sim;
-    memset(&sim, 0, sizeof sim);
+    else snprintf(out_dir, sizeof out_dir, "out/%s-%s", scene->name, solver->name);
     FILE *steps_csv = NULL, *frames_csv = NULL, *iters_csv = NULL;
     VtkSeries vtk;
     memset(&vtk, 0, sizeof vtk);
@@ -359,8 +273,8 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     if (!(steps_csv = open_in(out_dir, "steps.csv", &status))) goto done;
     if (!(frames_csv = open_in(out_dir, "frames.csv", &status))) goto done;
     if (cfg->history && !(iters_csv = open_in(out_dir, "iters.csv", &status))) goto done;
-    if ((status = run_accuracy_open(&acc, out_dir, &scene))) goto done;
-    write_run_json(out_dir, cfg, &scene, solver, &set, &acc, frames, threads, &status);
+    if ((status = run_accuracy_open(&acc, out_dir, scene))) goto done;
+    write_run_json(out_dir, cfg, scene, solver, &set, &acc, frames, threads, &status);
     if (status) goto done;
     fprintf(steps_csv, "scene,solver,frame,step,t,dt,particles,active_nodes,hessian_blocks,outer_iters,linear_iters,"
                        "ls_evals,residual,status,wall_s,p2g_s,assemble_s,setup_s,solve_s,linesearch_s,g2p_s,threads,"
@@ -372,22 +286,22 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
             run_accuracy_frame_header);
     if (iters_csv) fprintf(iters_csv, "frame,step,iter,elapsed_s,residual,energy\n");
 
-    if ((status = sim_init(&sim, &scene))) goto done;
-    if (cfg->vtk_dir && (status = vtk_series_frame(&vtk, 0, sim.t, &sim.p, scene.materials, scene.n_materials, NULL,
-                                                   NULL)))
+    if (cfg->vtk_dir && (status = vtk_series_frame(&vtk, 0, sim->t, &sim->p, scene->materials, scene->n_materials,
+                                                   NULL, NULL)))
         goto done;
-    sum->particles = scene.particles.n;
+    sum->particles = scene->particles.n;
     sum->threads = threads;
     if (!cfg->quiet) {
-        printf("scene %s (%zu particles, dx %.4g m), solver %s, eps %.1e, %d threads\n", scene.name, scene.particles.n,
-               scene.dx, solver->name, cfg->eps, threads);
+        printf("scene %s (%zu particles, dx %.4g m), solver %s, eps %.1e, %d threads\n", scene->name, scene->particles.n,
+               scene->dx, solver->name, cfg->eps, threads);
         if (acc.ref) printf("error reference: %s (its time is in ref_s, not in the timings)\n", error_ref_describe(acc.ref));
         printf("%6s %6s %8s %9s %9s %10s %12s  %s\n", "frame", "steps", "outer", "linear", "inner", "wall_s",
                "max_resid", "status");
     }
-    RunOutput out = {cfg, &scene, solver, &acc, steps_csv, frames_csv, iters_csv, threads, cfg->vtk_dir ? &vtk : NULL};
+    RunOutput out = {cfg, scene, solver, &acc, steps_csv, frames_csv, iters_csv, threads, cfg->vtk_dir ? &vtk : NULL};
     FrameDriver driver = {.frames = frames,
-                          .apply_failed = cfg->on_failure == RUN_CONTINUE,
+                          .on_failure = cfg->on_failure,
+                          .progress = 1,
                           .max_step_s = cfg->max_step_s,
                           .max_run_s = cfg->max_run_s,
                           .before_step = before_step,
@@ -396,15 +310,16 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
                           .iteration = write_iteration,
                           .ctx = &out};
     char stop_reason[300];
-    if ((status = frame_driver_run(&driver, &sim, solver, &set, sum, stop_reason, sizeof stop_reason))) goto done;
+    if ((status = frame_driver_run(&driver, sim, solver, &set, &sum->totals, stop_reason, sizeof stop_reason))) goto done;
     fflush(steps_csv);
     fflush(frames_csv);
-    if (sum->stopped) fprintf(stderr, "mpmbench: run stopped: %s\n", stop_reason);
+    const DriveTotals *tot = &sum->totals;
+    if (tot->stopped) fprintf(stderr, "mpmbench: run stopped: %s\n", stop_reason);
     if (!cfg->quiet) {
         printf("total: %d frames, %d steps, %ld outer, %ld linear, %ld inner iterations, %.3f s wall (%.3f s/frame), "
                "worst status %s\n",
-               sum->frames, sum->steps, sum->outer_iters, sum->linear_iters, sum->inner_iters, sum->wall_s,
-               sum->frames ? sum->wall_s / sum->frames : 0.0, solve_status_name((SolveStatus)sum->worst_status));
+               tot->frames, tot->steps, tot->outer_iters, tot->linear_iters, tot->inner_iters, tot->wall_s,
+               tot->frames ? tot->wall_s / tot->frames : 0.0, solve_status_name((SolveStatus)tot->worst_status));
         printf("wrote %s/steps.csv and %s/frames.csv%s\n", out_dir, out_dir, iters_csv ? " and iters.csv" : "");
     }
     /* the parts' statistics through the view op: the hierarchy of the last
@@ -433,8 +348,6 @@ done:
     if (iters_csv) fclose(iters_csv);
     vtk_series_free(&vtk);
     run_accuracy_free(&acc);
-    sim_free(&sim);
-    solver_destroy(solver);
-    scene_free(&scene);
+    session_close(&ses);
     return status;
 }

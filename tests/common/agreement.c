@@ -7,7 +7,7 @@
 
 #include "core/error.h"
 #include "core/vec.h"
-#include "experiments/run/registry.h"
+#include "experiments/driver/registry.h"
 #include "tests/common/fixture.h"
 #include "tests/common/testutil.h"
 

@@ -10,7 +10,7 @@
 #include <string.h>
 
 #include "core/vec.h"
-#include "experiments/run/registry.h"
+#include "experiments/driver/registry.h"
 #include "solvers/solver.h"
 #include "tests/common/fixture.h"
 #include "tests/common/testutil.h"

@@ -44,7 +44,7 @@
 #include "core/error.h"
 #include "core/step.h"
 #include "core/vec.h"
-#include "experiments/run/registry.h"
+#include "experiments/driver/registry.h"
 #include "solvers/outer/gast15.h"
 #include "solvers/krylov/pcg.h"
 #include "tests/common/fixture.h"

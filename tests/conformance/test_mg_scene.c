@@ -23,7 +23,7 @@
 #include "core/step.h"
 #include "core/vec.h"
 #include "core/scene/scene_load.h"
-#include "experiments/run/registry.h"
+#include "experiments/driver/registry.h"
 #include "solvers/solver.h"
 #include "tests/common/testutil.h"
 

@@ -9,7 +9,7 @@
 #include "core/error.h"
 #include "core/step.h"
 #include "core/scene/scene_load.h"
-#include "experiments/run/registry.h"
+#include "experiments/driver/registry.h"
 #include "tests/common/testutil.h"
 
 static int first_step(const char *spec, SolveStats *out)

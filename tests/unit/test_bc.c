@@ -9,7 +9,7 @@
 
 #include "core/error.h"
 #include "core/mat3.h"
-#include "experiments/run/registry.h"
+#include "experiments/driver/registry.h"
 #include "solvers/solver.h"
 #include "tests/common/fixture.h"
 #include "tests/common/testutil.h"

@@ -21,8 +21,8 @@
 #include "core/step.h"
 #include "core/scene/scene_load.h"
 #include "experiments/accuracy/error_ref.h"
-#include "experiments/run/library_startup.h"
-#include "experiments/run/registry.h"
+#include "experiments/driver/library_startup.h"
+#include "experiments/driver/registry.h"
 #include "experiments/run/run.h"
 #include "tests/common/testutil.h"
 
@@ -55,7 +55,7 @@ static void first_step(const char *scene, double scale, const char *const *set, 
     SolveStats ss;
     StepInfo si;
     if (!st) {
-        st = run_step(&sim, solver, &set_, &w, NULL, NULL, 0, &ss, &si);
+        st = time_step_run(&sim, solver, &set_, &w, NULL, NULL, 0, &ss, &si);
         CHECK(st == MPM_OK && ss.status == SOLVE_CONVERGED, "%s step at eps %g: %s (%s)", solver_spec, eps,
               solve_status_name(ss.status), st ? mpm_last_error() : ss.reason);
         *e = *error_ref_last(ref);
@@ -180,7 +180,7 @@ static void hook_time_and_cache(void)
         SolveStats ss;
         StepInfo si;
         double t0 = omp_get_wtime();
-        st = run_step(&sim, solver, &set, &w, NULL, NULL, 0, &ss, &si);
+        st = time_step_run(&sim, solver, &set, &w, NULL, NULL, 0, &ss, &si);
         double total = omp_get_wtime() - t0;
         CHECK(st == MPM_OK, "step: %s", mpm_last_error());
         CHECK(si.after_solve_s >= 0.3, "the hook's time %g s is reported", si.after_solve_s);

@@ -25,7 +25,7 @@
 #include "core/mat3.h"
 #include "core/step.h"
 #include "core/scene/scene_load.h"
-#include "experiments/run/registry.h"
+#include "experiments/driver/registry.h"
 #include "tests/common/testutil.h"
 
 static void random_unit(unsigned long long *rs, double n[3])

@@ -16,7 +16,7 @@
 #include "core/error.h"
 #include "core/step.h"
 #include "core/scene/scene_load.h"
-#include "experiments/run/registry.h"
+#include "experiments/driver/registry.h"
 #include "experiments/run/run.h"
 #include "tests/common/testutil.h"
 
@@ -64,7 +64,7 @@ static void breakdown_policy(void)
         st = sim_init(&sim, &sc);
         mpm_clear_error();
         g_fail_status = MPM_ENUMERIC;
-        int rc = run_step(&sim, solver, &set, &w, NULL, NULL, apply, &ss, &si);
+        int rc = time_step_run(&sim, solver, &set, &w, NULL, NULL, apply, &ss, &si);
         CHECK(rc == MPM_OK, "apply %d: a breakdown is a status, not an error (rc %d)", apply, rc);
         CHECK(ss.status == SOLVE_FAILED && strcmp(ss.reason, "mock breakdown in numerics") == 0,
               "apply %d: status %s, reason '%s'", apply, solve_status_name(ss.status), ss.reason);
@@ -74,7 +74,7 @@ static void breakdown_policy(void)
         CHECK(si.dt > 0 && si.active_nodes > 0, "apply %d: the row has dt %g and %d nodes", apply, si.dt,
               si.active_nodes);
         g_fail_status = MPM_EINTERNAL;
-        rc = run_step(&sim, solver, &set, &w, NULL, NULL, apply, &ss, &si);
+        rc = time_step_run(&sim, solver, &set, &w, NULL, NULL, apply, &ss, &si);
         CHECK(rc == MPM_EINTERNAL, "apply %d: an internal error stays an error (rc %d)", apply, rc);
         mpm_clear_error();
         free(w.dv);

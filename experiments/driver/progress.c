@@ -1,4 +1,4 @@
-#include "experiments/run/progress.h"
+#include "experiments/driver/progress.h"
 
 #include <omp.h>
 #include <stdio.h>

@@ -1,5 +1,5 @@
 /* The frame driver (frame_driver.h). */
-#include "experiments/run/frame_driver.h"
+#include "experiments/driver/frame_driver.h"
 
 #include <omp.h>
 #include <stdio.h>
@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "core/error.h"
-#include "experiments/run/progress.h"
+#include "experiments/driver/progress.h"
 
 typedef struct {
     const FrameDriver *d;
@@ -42,17 +42,19 @@ static void set_deadline(const FrameDriver *d, double run_t0, SolveSettings *set
     }
 }
 
-int frame_driver_run(const FrameDriver *d, Simulation *sim, Solver *solver, SolveSettings *set, RunSummary *sum,
+int frame_driver_run(const FrameDriver *d, Simulation *sim, Solver *solver, SolveSettings *set, DriveTotals *sum,
                      char *stop_reason, size_t reason_len)
 {
     int status = MPM_OK;
     StepWork work = {.dv = NULL, .cap = 0};
     Progress prog;
     progress_init(&prog, d->frames);
+    if (!d->progress) prog.enabled = 0;
     Iteration hook = {d, &prog, 0, 0, 0.0};
     char deadline_why[64];
     stop_reason[0] = '\0';
     double run_t0 = omp_get_wtime();
+    memset(sum, 0, sizeof *sum);
     while (sim->frame < d->frames && !sum->stopped) {
         FrameSums f;
         memset(&f, 0, sizeof f);
@@ -66,7 +68,9 @@ int frame_driver_run(const FrameDriver *d, Simulation *sim, Solver *solver, Solv
             if (d->before_step && (status = d->before_step(d->ctx, sim, f.frame, f.steps, &work))) goto done;
             SolveStats ss;
             StepInfo si;
-            if ((status = run_step(sim, solver, set, &work, on_iteration, &hook, d->apply_failed, &ss, &si))) goto done;
+            if ((status = time_step_run(sim, solver, set, &work, on_iteration, &hook, d->on_failure == FAILURE_CONTINUE,
+                                        &ss, &si)))
+                goto done;
             run_t0 += si.after_solve_s; /* a reference solve is not the run's time */
             if (d->after_step && (status = d->after_step(d->ctx, sim, f.frame, f.steps, &ss, &si))) goto done;
             f.steps++;
@@ -108,6 +112,6 @@ int frame_driver_run(const FrameDriver *d, Simulation *sim, Solver *solver, Solv
     sum->wall_s = omp_get_wtime() - run_t0;
 done:
     progress_clear(&prog);
-    free(work.dv);
+    time_step_work_free(&work);
     return status;
 }

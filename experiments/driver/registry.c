@@ -1,4 +1,4 @@
-#include "experiments/run/registry.h"
+#include "experiments/driver/registry.h"
 
 #include <stdio.h>
 #include <string.h>

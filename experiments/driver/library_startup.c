@@ -1,4 +1,4 @@
-#include "experiments/run/library_startup.h"
+#include "experiments/driver/library_startup.h"
 
 #include <omp.h>
 
