@@ -604,7 +604,7 @@ const InvApproxOps inv_boomeramg_ops = {"boomeramg", "one hypre BoomerAMG V-cycl
                                         amg_create,  amg_setup,
                                         amg_apply,   amg_view,
                                         amg_destroy, boomeramg_library_startup,
-                                        amg_reuse};
+                                        amg_reuse,   boomeramg_library_version};
 
 /* ---- library start-up and version (header: "Start-up") ---- */
 

@@ -328,7 +328,7 @@ const InvApproxOps inv_cholmod_ops = {"cholmod", "CHOLMOD sparse Cholesky factor
                                       chol_create,  chol_setup,
                                       chol_apply,   chol_view,
                                       chol_destroy, cholmod_library_startup,
-                                      chol_reuse};
+                                      chol_reuse,   cholmod_library_version};
 
 /* ---- library start-up and version (header: "Start-up") ---- */
 

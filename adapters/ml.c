@@ -418,4 +418,4 @@ const InvApproxOps inv_ml_ops = {"ml",       "one Trilinos ML smoothed-aggregati
                                  ml_create,  ml_setup,
                                  ml_apply,   ml_view,
                                  ml_destroy, ml_library_startup,
-                                 ml_reuse};
+                                 ml_reuse,   ml_library_version};

@@ -1,8 +1,8 @@
 # Finds every third-party dependency, says which Debian package provides a
 # missing one, and gives each an imported target that the floor using it
-# links PRIVATE (docs/design.md, floors). hypre, CHOLMOD and Trilinos ML are
-# optional: MPM_WITH_HYPRE, MPM_WITH_CHOLMOD and MPM_WITH_ML are ON when the
-# library is found.
+# links PRIVATE (docs/design.md, floors). The adapters' libraries (hypre,
+# CHOLMOD, Trilinos ML; adapters/adapter_list.h) are optional: each adapter's
+# option (MPM_WITH_HYPRE, ...) is ON when its library is found.
 
 function(mpm_require found what package)
   if(NOT ${found})
@@ -52,34 +52,50 @@ mpm_library(MPM::jansson ${JANSSON_INCLUDE_DIR} ${JANSSON_LIBRARY})
 find_package(PNG)
 mpm_require(PNG_FOUND "libpng" "libpng-dev")
 
-# Optional adapters.
+# Optional adapters: adapters/adapter_list.h has one line per adapter (its
+# name, the option that builds it, its Debian package, its library's key in
+# run.json, what it is); here each adapter's library is found (a block per
+# adapter, setting MPM_ADAPTER_<name>_FOUND and _LIBS), and the option made.
 find_path(HYPRE_INCLUDE_DIR HYPRE.h PATH_SUFFIXES hypre)
 find_library(HYPRE_LIBRARY NAMES HYPRE)
+set(MPM_ADAPTER_boomeramg_FOUND OFF)
 if(HYPRE_INCLUDE_DIR AND HYPRE_LIBRARY)
   mpm_library(MPM::hypre ${HYPRE_INCLUDE_DIR} ${HYPRE_LIBRARY})
-  set(MPM_HYPRE_FOUND ON)
-else()
-  set(MPM_HYPRE_FOUND OFF)
+  set(MPM_ADAPTER_boomeramg_FOUND ON)
 endif()
-mpm_optional(MPM_WITH_HYPRE MPM_HYPRE_FOUND "hypre BoomerAMG" "libhypre-dev")
+set(MPM_ADAPTER_boomeramg_LIBS MPM::hypre MPI::MPI_C OpenMP::OpenMP_C)
 
 find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse)
 find_library(CHOLMOD_LIBRARY cholmod)
+set(MPM_ADAPTER_cholmod_FOUND OFF)
 if(CHOLMOD_INCLUDE_DIR AND CHOLMOD_LIBRARY)
   mpm_library(MPM::cholmod ${CHOLMOD_INCLUDE_DIR} ${CHOLMOD_LIBRARY})
-  set(MPM_CHOLMOD_FOUND ON)
-else()
-  set(MPM_CHOLMOD_FOUND OFF)
+  set(MPM_ADAPTER_cholmod_FOUND ON)
 endif()
-mpm_optional(MPM_WITH_CHOLMOD MPM_CHOLMOD_FOUND "CHOLMOD" "libsuitesparse-dev")
+set(MPM_ADAPTER_cholmod_LIBS MPM::cholmod OpenMP::OpenMP_C)
 
-# Trilinos ML (adapters/ml.c: presets pn-ml-pcg and lbfgs-ml).
 find_path(ML_INCLUDE_DIR ml_include.h PATH_SUFFIXES trilinos)
 find_library(ML_LIBRARY trilinos_ml)
+set(MPM_ADAPTER_ml_FOUND OFF)
 if(ML_INCLUDE_DIR AND ML_LIBRARY)
   mpm_library(MPM::ml ${ML_INCLUDE_DIR} ${ML_LIBRARY})
-  set(MPM_ML_FOUND ON)
-else()
-  set(MPM_ML_FOUND OFF)
+  set(MPM_ADAPTER_ml_FOUND ON)
 endif()
-mpm_optional(MPM_WITH_ML MPM_ML_FOUND "Trilinos ML" "libtrilinos-ml-dev")
+set(MPM_ADAPTER_ml_LIBS MPM::ml MPI::MPI_C OpenMP::OpenMP_C)
+
+set(MPM_ADAPTERS "")
+file(STRINGS ${CMAKE_CURRENT_SOURCE_DIR}/adapters/adapter_list.h mpm_adapter_lines REGEX "^ *X\\(")
+string(REPLACE "\\" "" mpm_adapter_lines "${mpm_adapter_lines}") # the macro's line continuations
+foreach(line ${mpm_adapter_lines})
+  if(NOT line MATCHES "X\\(([a-z0-9_]+), *([A-Z0-9_]+), *\"([^\"]+)\", *\"([^\"]+)\", *\"([^\"]+)\"\\)")
+    message(FATAL_ERROR "adapters/adapter_list.h: cannot read the line '${line}'")
+  endif()
+  set(name ${CMAKE_MATCH_1})
+  if(NOT DEFINED MPM_ADAPTER_${name}_FOUND)
+    message(FATAL_ERROR "adapters/adapter_list.h names the adapter ${name}, but cmake/MpmDependencies.cmake has no "
+                        "block finding its library (MPM_ADAPTER_${name}_FOUND)")
+  endif()
+  list(APPEND MPM_ADAPTERS ${name})
+  set(MPM_ADAPTER_${name}_OPTION ${CMAKE_MATCH_2})
+  mpm_optional(${CMAKE_MATCH_2} MPM_ADAPTER_${name}_FOUND "${CMAKE_MATCH_5}" "${CMAKE_MATCH_3}")
+endforeach()

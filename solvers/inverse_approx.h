@@ -9,7 +9,7 @@
  *
  * An implementation embeds `InvApprox` as its first member, sets `caps` in
  * create and provides an InvApproxOps table; adding one is a new file plus
- * one line in experiments/run/registry.c. Nothing outside the implementation's
+ * one line in experiments/driver/registry.c. Nothing outside the implementation's
  * file knows its type: its statistics come through the view op. Callers go
  * through the inv_* wrappers below, which keep the object's state (apply
  * before a successful setup is refused) and count inner iterations across
@@ -112,6 +112,9 @@ typedef struct {
      * Either way the result must keep the caps (symmetric, positive).
      * NULL: the implementation is set up afresh at every request. */
     int (*reuse)(InvApprox *self, const InvSetupInput *in, int values, int *refreshed);
+    /* The version of the library behind the implementation (run.json's
+     * provenance); NULL: in-house, no library. */
+    const char *(*library_version)(void);
 } InvApproxOps;
 
 /* Setup reuse counters (since creation): every inv_setup call is one

@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "core/error.h"
-#include "experiments/matrix/matrix_csv.h"
+#include "experiments/io/csv_table.h"
 
 int reference_run_check(const char *flag, const char *dir, const char *scene, size_t particles)
 {

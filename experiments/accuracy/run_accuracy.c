@@ -7,7 +7,7 @@
 #include <sys/stat.h>
 
 #include "core/error.h"
-#include "experiments/run/csv_write.h"
+#include "experiments/io/csv_write.h"
 
 const char *const run_accuracy_step_header = "err_h,e_gap,err_v_max,ref_solver,ref_status,ref_s";
 const char *const run_accuracy_frame_header = "pos_rms,pos_max,vel_rms";

@@ -1,5 +1,5 @@
 /* The registry: which outer methods, inverse approximations and named
- * presets exist (docs/design.md, floor 4: the only file that knows every
+ * presets exist (docs/design.md, floors: the only file that knows every
  * implementation, adapters included). It is data: one line per part, one
  * line per preset.
  *
@@ -34,6 +34,12 @@ const SolverPreset *registry_find_preset(const char *name); /* NULL when unknown
 int registry_outer_count(void);
 const OuterMethodOps *registry_outer(int i);
 const OuterMethodOps *registry_find_outer(const char *name);
+
+/* The optional adapters (adapters/adapter_list.h), built or not: adapter i's
+ * library as run.json's provenance names it ("hypre") and its version ("not
+ * built" when this build left the adapter out). */
+int registry_adapter_count(void);
+void registry_adapter_library(int i, const char **key, const char **version);
 
 int registry_inverse_count(void);
 const InvApproxOps *registry_inverse(int i);

@@ -21,7 +21,7 @@
 #include <stddef.h>
 
 #include "experiments/matrix/matrix_cells.h"
-#include "experiments/matrix/matrix_csv.h"
+#include "experiments/io/csv_table.h"
 
 typedef struct {
     int pass;

@@ -10,7 +10,7 @@
 #include "core/error.h"
 #include "experiments/matrix/matrix_child.h"
 #include "experiments/matrix/matrix_results.h"
-#include "experiments/run/paths.h"
+#include "experiments/io/paths.h"
 
 enum { TAG_REQUEST = 1, TAG_TASK = 2, TAG_STOP = 3, TAG_RESULT = 4 };
 enum { POLL_MS = 5, MAX_ARGS = 512 };

@@ -7,7 +7,7 @@
 #include <sys/wait.h>
 
 #include "core/error.h"
-#include "experiments/matrix/matrix_csv.h"
+#include "experiments/io/csv_table.h"
 
 const char *cell_status_name(CellStatus s)
 {

@@ -18,7 +18,7 @@
 #define MPM_MATRIX_RESULTS_H
 
 #include "experiments/matrix/matrix_cells.h"
-#include "experiments/matrix/matrix_csv.h"
+#include "experiments/io/csv_table.h"
 #include "experiments/matrix/matrix_measure.h"
 
 typedef struct {

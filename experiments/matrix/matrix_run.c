@@ -15,7 +15,7 @@
 #include "experiments/matrix/matrix_dispatch.h"
 #include "experiments/matrix/matrix_file.h"
 #include "experiments/matrix/matrix_results.h"
-#include "experiments/run/paths.h"
+#include "experiments/io/paths.h"
 #include "experiments/matrix/matrix_validate.h"
 #include "experiments/run/provenance.h"
 

@@ -10,19 +10,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#if MPM_WITH_CHOLMOD
-#include "adapters/cholmod.h"
-#else
-static const char *cholmod_library_version(void) { return "not built"; }
-#endif
-#if MPM_WITH_HYPRE
-#include "adapters/boomeramg.h"
-#else
-static const char *boomeramg_library_version(void) { return "not built"; }
-#endif
-#if MPM_WITH_ML
-#include "adapters/ml.h"
-#endif
+#include "experiments/driver/registry.h"
 #include "mpm_build_info.h" /* generated at build time: MPM_GIT_COMMIT, MPM_GIT_DIRTY */
 
 #ifndef MPM_BUILD_FLAGS
@@ -144,11 +132,15 @@ json_t *provenance_json(int threads, int with_checkout)
                               MPM_GIT_DIRTY < 0 ? json_null() : json_boolean(MPM_GIT_DIRTY > 0),
                               "compiler", MPM_COMPILER, "flags", MPM_BUILD_FLAGS, "build_type",
                               MPM_BUILD_TYPE);
-    json_t *libs = json_pack("{s:s, s:s, s:s, s:s, s:s}", "hypre", boomeramg_library_version(), "cholmod",
-                             cholmod_library_version(), "openblas", openblas, "mpi", mpi, "jansson", jansson);
-#if MPM_WITH_ML
-    if (libs) json_object_set_new(libs, "trilinos_ml", json_string(ml_library_version()));
-#endif
+    json_t *libs = json_object();
+    for (int i = 0; libs && i < registry_adapter_count(); ++i) { /* "not built" when the build left one out */
+        const char *key, *version;
+        registry_adapter_library(i, &key, &version);
+        json_object_set_new(libs, key, json_string(version));
+    }
+    if (libs) json_object_set_new(libs, "openblas", json_string(openblas));
+    if (libs) json_object_set_new(libs, "mpi", json_string(mpi));
+    if (libs) json_object_set_new(libs, "jansson", json_string(jansson));
     json_t *envs = json_pack("{s:s, s:s, s:s, s:s}", "OMP_WAIT_POLICY", env_or_empty("OMP_WAIT_POLICY"),
                              "OMP_NUM_THREADS", env_or_empty("OMP_NUM_THREADS"), "OMP_PROC_BIND",
                              env_or_empty("OMP_PROC_BIND"), "OMP_PLACES", env_or_empty("OMP_PLACES"));

@@ -8,7 +8,7 @@
 
 #include "core/error.h"
 #include "core/fcr.h"
-#include "experiments/run/paths.h"
+#include "experiments/io/paths.h"
 
 int vtk_series_open(VtkSeries *s, const char *dir, int grid)
 {

@@ -137,4 +137,4 @@ static void gd_destroy(InvApprox *self)
 const InvApproxOps inv_gast_diagonal_ops = {
     "gast-diagonal",
     "diagonal of the rest-configuration stiffness, matrix-free (Gast et al. 2015 section 6.2)",
-    gd_create, gd_setup, gd_apply, gd_view, gd_destroy, NULL, NULL};
+    gd_create, gd_setup, gd_apply, gd_view, gd_destroy, NULL, NULL, NULL};

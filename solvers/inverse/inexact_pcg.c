@@ -112,4 +112,4 @@ const InvApproxOps inv_inexact_pcg_ops = {
     "inexact-pcg", "block-Jacobi PCG from zero to 1/2 of the input's norm (HOT LBFGS-H, SPEC 7)",
     ipcg_create,   ipcg_setup,
     ipcg_apply,    ipcg_view,
-    ipcg_destroy,  NULL, NULL};
+    ipcg_destroy,  NULL, NULL, NULL};

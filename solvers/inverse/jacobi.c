@@ -121,6 +121,6 @@ static void jacobi_destroy(InvApprox *self)
 
 const InvApproxOps inv_block_jacobi_ops = {"block-jacobi",
                                            "inverse 3x3 diagonal blocks of the Hessian (HOT's default Jacobi)",
-                                           block_create, jacobi_setup, jacobi_apply, jacobi_view, jacobi_destroy, NULL, NULL};
+                                           block_create, jacobi_setup, jacobi_apply, jacobi_view, jacobi_destroy, NULL, NULL, NULL};
 const InvApproxOps inv_scalar_jacobi_ops = {"jacobi", "inverse diagonal entries of the Hessian (scalar Jacobi)",
-                                            scalar_create, jacobi_setup, jacobi_apply, jacobi_view, jacobi_destroy, NULL, NULL};
+                                            scalar_create, jacobi_setup, jacobi_apply, jacobi_view, jacobi_destroy, NULL, NULL, NULL};

@@ -135,4 +135,4 @@ static void sgs_destroy(InvApprox *self)
 }
 
 const InvApproxOps inv_sgs_ops = {"sgs", "one coloured symmetric block Gauss-Seidel sweep from zero (HOT Table 3)",
-                                  sgs_create, sgs_setup, sgs_apply, sgs_view, sgs_destroy, NULL, NULL};
+                                  sgs_create, sgs_setup, sgs_apply, sgs_view, sgs_destroy, NULL, NULL, NULL};

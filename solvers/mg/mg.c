@@ -81,7 +81,7 @@ static int cj_apply(InvApprox *self, const double *r, double *z)
     return MPM_OK;
 }
 static const InvApproxOps coarse_jacobi_ops = {"mg-coarse-jacobi", "the coarsest level's block Jacobi", NULL, NULL,
-                                               cj_apply, NULL, NULL, NULL, NULL};
+                                               cj_apply, NULL, NULL, NULL, NULL, NULL};
 
 static void level_spmv(const void *ctx, const double *x, double *y) { bsr_spmv((const Bsr *)ctx, x, y); }
 
@@ -486,4 +486,5 @@ const InvApproxOps inv_mg_ops = {
     mg_view,
     mg_destroy,
     NULL,
-    mg_reuse};
+    mg_reuse,
+    NULL};

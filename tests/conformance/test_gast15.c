@@ -497,7 +497,7 @@ static void probe_view(const InvApprox *self, FILE *f, InvView *out)
 }
 static void probe_destroy(InvApprox *self) { free(self); }
 static const InvApproxOps g_probe_ops = {"probe", "records the tangent", probe_create, probe_setup, probe_apply,
-                                         probe_view, probe_destroy, NULL, NULL};
+                                         probe_view, probe_destroy, NULL, NULL, NULL};
 static int probe_create(SolverOptions *opt, InvApprox **out)
 {
     (void)opt;

@@ -25,10 +25,10 @@
 #include "core/error.h"
 #include "experiments/matrix/matrix_cells.h"
 #include "experiments/matrix/matrix_child.h"
-#include "experiments/matrix/matrix_csv.h"
+#include "experiments/io/csv_table.h"
 #include "experiments/matrix/matrix_measure.h"
 #include "experiments/matrix/matrix_results.h"
-#include "experiments/run/paths.h"
+#include "experiments/io/paths.h"
 #include "tests/common/testutil.h"
 
 static char g_dir[256];

@@ -20,7 +20,7 @@
 #include <string.h>
 
 #include "core/error.h"
-#include "experiments/cli/commands.h"
+#include "experiments/commands/commands.h"
 #include "experiments/cli/run_settings.h"
 #include "experiments/matrix/matrix_cells.h"
 #include "tests/common/testutil.h"

@@ -1,4 +1,4 @@
-#include "experiments/run/paths.h"
+#include "experiments/io/paths.h"
 
 #include <errno.h>
 #include <stdio.h>

@@ -1,6 +1,6 @@
 /* The commands of mpmbench (commands.h): list, run and bench here; render
  * and the matrix commands beside their code. */
-#include "experiments/cli/commands.h"
+#include "experiments/commands/commands.h"
 
 #include <stddef.h>
 #include <stdlib.h>

@@ -1,4 +1,4 @@
-#include "experiments/matrix/matrix_csv.h"
+#include "experiments/io/csv_table.h"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -1,4 +1,4 @@
-/* The commands of mpmbench and the program's entry (experiments/cli/main.c
+/* The commands of mpmbench and the program's entry (experiments/commands/main.c
  * calls cli_main). The command line, the --help texts and the exit statuses
  * follow cli.h; this file lists the commands. */
 #ifndef MPM_COMMANDS_H

@@ -1,4 +1,4 @@
-#include "experiments/run/csv_write.h"
+#include "experiments/io/csv_write.h"
 
 #include <string.h>
 

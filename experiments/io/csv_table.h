@@ -1,7 +1,7 @@
-/* CSV tables read by column name (RFC 4180 quoting), so the matrix runner
- * keeps working when a table gains columns. */
-#ifndef MPM_MATRIX_CSV_H
-#define MPM_MATRIX_CSV_H
+/* CSV tables read by column name (RFC 4180 quoting), so readers (the matrix
+ * runner, --dt-from) keep working when a table gains columns. */
+#ifndef MPM_CSV_TABLE_H
+#define MPM_CSV_TABLE_H
 
 #include <stddef.h>
 
