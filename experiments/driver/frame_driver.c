@@ -86,8 +86,8 @@ int frame_driver_run(const FrameDriver *d, Simulation *sim, Solver *solver, Solv
                 sum->stopped = 1;
                 break;
             }
-            if (d->max_run_s > 0 && omp_get_wtime() - run_t0 >= d->max_run_s) {
-                /* the run's budget is spent: this step was the last */
+            if (d->max_run_s > 0 && sim->frame < d->frames && omp_get_wtime() - run_t0 >= d->max_run_s) {
+                /* the run's budget is spent with frames left: this step was the last */
                 snprintf(stop_reason, reason_len, "time limit --max-run-seconds %g reached at frame %d step %d",
                          d->max_run_s, f.frame, f.steps - 1);
                 if (sim->frame == f.frame && f.status < SOLVE_TIMEOUT) { /* the frame is cut short */
@@ -108,6 +108,15 @@ int frame_driver_run(const FrameDriver *d, Simulation *sim, Solver *solver, Solv
         sum->inner_iters += f.inner_iters;
         if (f.max_residual > sum->max_residual) sum->max_residual = f.max_residual;
         sum->worst_status = worse(sum->worst_status, f.status);
+        if (sum->stopped && f.completed && sim->frame < d->frames) {
+            /* the budget ran out exactly at a frame's end: the next frame is
+             * handed over as cut short before its first step, so that its
+             * row, not only stderr, says why the run ended early */
+            FrameSums next = {.frame = sim->frame, .status = SOLVE_TIMEOUT};
+            snprintf(next.reason, sizeof next.reason, "%s", stop_reason);
+            if (d->after_frame && (status = d->after_frame(d->ctx, sim, &next, 1))) goto done;
+            sum->worst_status = worse(sum->worst_status, next.status);
+        }
     }
     sum->wall_s = omp_get_wtime() - run_t0;
 done:

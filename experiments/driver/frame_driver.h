@@ -29,7 +29,9 @@ typedef struct {
     int stopped;                /* the drive ended early (failure policy or the run's time budget) */
 } DriveTotals;
 
-/* The sums of one frame (a frame cut short by a stop has the steps it ran). */
+/* The sums of one frame (a frame cut short by a stop has the steps it ran;
+ * when the run's time budget ends exactly at a frame's end, the next frame
+ * is handed over with no steps, status timeout and the stop's reason). */
 typedef struct {
     int frame, steps;
     long outer_iters, linear_iters, inner_iters;
