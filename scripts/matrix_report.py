@@ -63,7 +63,7 @@ Young's modulus (a key ending in ".E"; HOT Fig. 20); residual against time
 and against iterations for the cells run with --history (first step of the
 first timed frame, HOT Figs. 15-17). With report.mg_levels in the matrix,
 the blocks per row per multigrid level (HOT Fig. 8). A panel without data is
-left out with a line saying why. Style: scripts/mpm_style.py.
+left out with a line saying why. Style: scripts/figure_style.py.
 
 Accuracy (matrix_report_accuracy.py, beside this file): work precision and
 the robustness grid of `matrix run --check`.
@@ -80,7 +80,7 @@ import statistics
 import sys
 
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
-import mpm_style as style  # noqa: E402 (after the bytecode switch)
+import figure_style as style  # noqa: E402 (after the bytecode switch)
 
 STATUS_RANK = {"converged": 0, "capped": 1, "stalled": 2, "timeout": 3, "failed": 4}
 CASE_SKIP = {"id", "solver", "set", "solver_opts", "role", "reference", "repeat"}  # not part of a case key
