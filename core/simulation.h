@@ -6,7 +6,7 @@
 #include "core/grid.h"
 #include "core/position_update.h"
 #include "core/problem.h"
-#include "core/scene.h"
+#include "core/scene_description.h"
 
 typedef struct {
     const Scene *scene;

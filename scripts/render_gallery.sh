@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Renders the README gallery: every paper scene at its benchmark scale
+# Renders the gallery of initial states (results/scenes/): every paper scene at its benchmark scale
 # (about 50k-150k particles on 2 cores), initial state, iso view; the two
 # particle-source scenes also at a later frame (coarser, so it simulates in
 # minutes). Usage: scripts/render_gallery.sh [mpmbench binary]

@@ -1,5 +1,5 @@
 /* Loading scenes: JSON files describing one benchmark problem (the loaded
- * Scene is core/scene.h). The built-in scenes
+ * Scene is core/scene_description.h). The built-in scenes
  * are experiments/scenes/NAME.json; nothing is hard-coded in C.
  *
  * ------------------------------------------------------------------------
@@ -191,7 +191,7 @@
 
 #include <stddef.h>
 
-#include "core/scene.h"
+#include "core/scene_description.h"
 
 typedef struct {
     const char *key;

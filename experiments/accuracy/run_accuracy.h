@@ -1,4 +1,4 @@
-/* The accuracy attachments of a run (SPEC 11; README "Accuracy"), kept out
+/* The accuracy attachments of a run (SPEC 11; docs/accuracy.md), kept out
  * of the run loop: --error-ref (per-step error against a reference solve,
  * error_ref.h), --dt-from (the reference run's dt sequence, dt_replay.h),
  * --trajectory (write OUT/trajectory.bin) and --trajectory-ref (the
@@ -9,7 +9,7 @@
 
 #include <stdio.h>
 
-#include "core/scene.h"
+#include "core/scene_description.h"
 #include "experiments/driver/time_step.h"
 #include "experiments/accuracy/dt_replay.h"
 #include "experiments/accuracy/error_ref.h"

@@ -2,8 +2,8 @@
  * particles, the time-stepping settings) that the runtime reads. Reading it
  * from a scene file, the file format and the overrides are
  * core/scene/scene_load.h. */
-#ifndef MPM_SCENE_H
-#define MPM_SCENE_H
+#ifndef MPM_SCENE_DESCRIPTION_H
+#define MPM_SCENE_DESCRIPTION_H
 
 #include <stddef.h>
 
