@@ -19,7 +19,7 @@
 
 /* ------------------------------------------------------------------ list */
 
-static const char *const list_what[] = {"solvers", "scenes", NULL};
+static const char *const list_what[] = {"solvers", "scenes", "definitions", NULL};
 
 static void print_scene(const char *name, const char *desc, void *ctx)
 {
@@ -27,23 +27,45 @@ static void print_scene(const char *name, const char *desc, void *ctx)
     printf("%-16s %s\n", name, desc);
 }
 
+typedef struct {
+    const char *solver[OPT_LIST_MAX]; /* list definitions --solver SPEC: these specs instead of the presets */
+    int n_solver;
+} ListArgs;
+
+static const Option list_options[] = {
+    {"--solver", NULL, "SPEC", OPT_LIST, 0, 0, "a solver spec", NULL, offsetof(ListArgs, solver),
+     offsetof(ListArgs, n_solver), NULL, 0,
+     "with definitions: the definition of this spec (a preset, PRESET:k=v,... or OUTER:INVERSE[:k=v,...]) "
+     "instead of every preset's (repeatable)"},
+    {NULL}};
+
 static int list_run(void *args, const char *what, int *exit_code)
 {
-    (void)args, (void)exit_code;
+    (void)exit_code;
+    const ListArgs *a = args;
+    if (a->n_solver && strcmp(what, "definitions"))
+        return mpm_error(MPM_EINPUT, "list %s: --solver is for 'list definitions' only", what);
     if (!strcmp(what, "solvers")) {
         registry_print(stdout);
         return MPM_OK;
     }
+    if (!strcmp(what, "definitions"))
+        return a->n_solver ? registry_print_spec_definitions(stdout, a->solver, a->n_solver)
+                           : registry_print_definitions(stdout);
     return scene_list(print_scene, NULL);
 }
 
 static const Command list_command = {
     .name = "list",
-    .operand = "solvers|scenes",
+    .operand = "solvers|scenes|definitions",
     .operand_choices = list_what,
-    .operand_missing = "'solvers' or 'scenes'",
+    .operand_missing = "'solvers', 'scenes' or 'definitions'",
     .summary = "The registered solvers (presets, outer methods, inverse approximations and their options, "
-               "strategies) or the built-in scenes.",
+               "strategies), the built-in scenes, or each preset's resolved definition (every option with its "
+               "value in effect) and its hash, which run.json records.",
+    .groups = {{list_options, 0, NULL, 0, NULL, 0}},
+    .n_groups = 1,
+    .args_size = sizeof(ListArgs),
     .run = list_run};
 
 /* ------------------------------------------------------------------ run */

@@ -70,4 +70,13 @@ int solver_spec_check(const char *spec, const char *const *opts, int n_opts);
  * capabilities, line searches and stopping rules. */
 void registry_print(FILE *f);
 
+/* Writes one line per preset of this build: its name, the hash of its
+ * resolved definition (solvers/solver_definition.h) and the definition on
+ * one line ("outer=pn inverse=block-jacobi linesearch=halving ..."): what
+ * `mpmbench list definitions` prints, and what a study's run.json files are
+ * compared with to tell whether the study is current. */
+int registry_print_definitions(FILE *f);
+/* The same for the given specs, each line named by its spec. */
+int registry_print_spec_definitions(FILE *f, const char *const *specs, int n);
+
 #endif

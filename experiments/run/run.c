@@ -21,6 +21,7 @@
 #include "experiments/driver/registry.h"
 #include "experiments/accuracy/run_accuracy.h"
 #include "solvers/solver.h"
+#include "solvers/solver_definition.h"
 
 #define RUN_MAX_SOLVER_OPTS (RUN_MAX_LIST + 1) /* the user's, and linesearch=armijo for --armijo */
 
@@ -207,6 +208,15 @@ static void write_run_json(const char *dir, const RunConfig *cfg, const Scene *s
                              "solver_options", opts, "overrides", ovr, "eps", cfg->eps, "scale", cfg->scale, "dx",
                              sc->dx, "frames", frames, "threads", threads, "line_search", solver->ls->name, "limits",
                              limits, "particles", (json_int_t)sc->particles.n);
+    char definition[4096], hash[SOLVER_DEFINITION_HASH_LEN];
+    if (root && solver_definition(solver, definition, sizeof definition, hash) == MPM_OK) {
+        /* what the solver ran, whatever its name: a study is stale for it when
+         * the current build's definition of the same spec hashes differently */
+        json_object_set_new(root, "solver_definition", json_string(definition));
+        json_object_set_new(root, "solver_definition_hash", json_string(hash));
+    } else if (root) {
+        *status = MPM_EINTERNAL;
+    }
     if (root) json_object_set_new(root, "accuracy", (json_t *)run_accuracy_json(&ac, acc));
     if (root) json_object_set_new(root, "startup_s", json_real(library_startup_seconds()));
     /* threads each phase ran on: the inverse approximation's library may
