@@ -2,10 +2,10 @@
  * shares (see inverse_approx.h). */
 #include "solvers/inverse_approx.h"
 
-#include <omp.h>
 #include <string.h>
 
 #include "core/error.h"
+#include "core/step_phases.h"
 
 void inv_view_add(InvView *v, const char *key, double value)
 {
@@ -13,6 +13,16 @@ void inv_view_add(InvView *v, const char *key, double value)
     snprintf(v->stat[v->n_stats].key, sizeof v->stat[0].key, "%s", key);
     v->stat[v->n_stats].value = value;
     v->n_stats++;
+}
+
+int inv_events(EventId *setup, EventId *apply)
+{
+    EventId phase[STEP_PHASES];
+    int st = step_phases_register(phase);
+    *setup = phase[STEP_SETUP];
+    /* inside the solve's remainder: the direction (PCG, the two-loop recursion) */
+    if (!st) st = event_register("inverse_apply", phase[STEP_SOLVE], apply);
+    return st;
 }
 
 int inv_create(const InvApproxOps *ops, SolverOptions *opt, InvApprox **out)
@@ -32,10 +42,16 @@ int inv_create(const InvApproxOps *ops, SolverOptions *opt, InvApprox **out)
                          "solver option reuse_every=%d, reuse_across_steps=%d: inverse approximation '%s' cannot "
                          "reuse its setup (expected reuse_every=1, reuse_across_steps=0)",
                          every, across, ops->name);
+    EventId setup_event, apply_event;
+    if ((st = inv_events(&setup_event, &apply_event))) return st;
     InvApprox *M = NULL;
     st = ops->create(opt, &M);
     if (st) return st;
     M->ops = ops;
+    event_log_reset(&M->own_log);
+    M->log = &M->own_log;
+    M->setup_event = setup_event;
+    M->apply_event = apply_event;
     M->ready = 0;
     M->inner_banked = 0;
     M->reuse_every = every;
@@ -72,7 +88,9 @@ int inv_setup(InvApprox *M, const InvSetupInput *in)
     M->inner_banked += M->stats.inner_iters; /* the implementation restarts its count */
     M->stats.inner_iters = 0;
     M->stats.apply_s = 0.0;
-    double t0 = omp_get_wtime();
+    const double before = event_log_seconds(M->log, M->setup_event);
+    int st = event_log_begin(M->log, M->setup_event);
+    if (st) return st;
     const int first = M->solve_requests++ == 0;
     M->reuse.requests++;
     int reuse = 0;
@@ -85,7 +103,6 @@ int inv_setup(InvApprox *M, const InvSetupInput *in)
         reuse = allowed && key == M->key;
         if (allowed && !reuse) M->reuse.pattern_misses++;
     }
-    int st;
     if (reuse) {
         int refreshed = 0;
         st = M->ops->reuse(M, in, M->reuse_refresh, &refreshed);
@@ -102,7 +119,8 @@ int inv_setup(InvApprox *M, const InvSetupInput *in)
         M->have_key = st == MPM_OK && M->ops->reuse;
     }
     if (st) M->have_key = 0; /* a failed reuse leaves nothing to reuse */
-    M->stats.setup_s = omp_get_wtime() - t0;
+    st = event_log_end_with(M->log, M->setup_event, st);
+    M->stats.setup_s = event_log_seconds(M->log, M->setup_event) - before;
     M->ready = st == MPM_OK;
     return st;
 }
@@ -110,9 +128,11 @@ int inv_setup(InvApprox *M, const InvSetupInput *in)
 int inv_apply(InvApprox *M, const double *r, double *z)
 {
     if (!M->ready) return mpm_error(MPM_EINTERNAL, "%s: applied without a successful setup", M->ops->name);
-    double t0 = omp_get_wtime();
-    int st = M->ops->apply(M, r, z);
-    M->stats.apply_s += omp_get_wtime() - t0;
+    const double before = event_log_seconds(M->log, M->apply_event);
+    int st = event_log_begin(M->log, M->apply_event);
+    if (st) return st;
+    st = event_log_end_with(M->log, M->apply_event, M->ops->apply(M, r, z));
+    M->stats.apply_s += event_log_seconds(M->log, M->apply_event) - before;
     return st;
 }
 

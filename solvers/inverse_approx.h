@@ -22,6 +22,8 @@
 #include <stdio.h>
 
 #include "core/bsr.h"
+#include "core/deadline.h"
+#include "core/event_log.h"
 #include "core/node_order.h"
 #include "solvers/krylov/linear_op.h"
 #include "solvers/options.h"
@@ -37,10 +39,10 @@ typedef struct {
     const LinearOp *op;        /* the BC-projected Hessian as an operator */
     const Projection *proj;    /* Dirichlet projection of vectors */
     struct StepProblem *problem; /* for rediscretising methods (GMG) */
-    /* omp_get_wtime() after which an inner iteration does not start (the
-     * solve's --max-step-seconds / --max-run-seconds deadline; 0 = none):
-     * an inner solve stops there with its current iterate */
-    double deadline;
+    /* the solve's deadline (--max-step-seconds / --max-run-seconds): past
+     * it no inner iteration starts, an inner solve stops with its current
+     * iterate */
+    Deadline deadline;
 } InvSetupInput;
 
 /* Capability flags (InvApprox.caps, set by create from the options). */
@@ -54,7 +56,9 @@ enum {
     INV_INNER_ITERS = 1u << 6,   /* apply iterates inside (counts InvStats.inner_iters) */
 };
 
-/* Work done since the last setup. */
+/* Work done since the last setup. The seconds are the wrappers' intervals
+ * in InvApprox.log (0 when it is NULL): setup_s of the last setup request,
+ * apply_s of the applies since. */
 typedef struct {
     long inner_iters;   /* iterations inside (coarse PCG, LBFGS-H's PCG) */
     double setup_s, apply_s;
@@ -137,6 +141,14 @@ struct InvApprox {
     /* threads the library behind setup and apply runs on (hypre: 1 in
      * Debian's build); 0 = the run's OpenMP threads. Set by create. */
     int setup_threads, apply_threads;
+    /* where the wrappers time setup (the step phase "setup") and apply
+     * (the event "inverse_apply", a sub-phase of "solve"), and an
+     * implementation its own sub-phases: &own_log, set by inv_create,
+     * unless its user hands another (solver_solve: the solve's log, for the
+     * solve); NULL: nothing is timed */
+    EventLog *log;
+    EventLog own_log;
+    EventId setup_event, apply_event; /* registered by inv_create */
     /* kept by the wrappers */
     int ready;          /* the last setup succeeded */
     long inner_banked;  /* inner iterations of setups before the current one */
@@ -149,6 +161,11 @@ struct InvApprox {
     uint64_t key;         /* hash of the nodes (coordinates) and the pattern id */
     InvReuseStats reuse;
 };
+
+/* The wrappers' events (registered on the first call): the step phase
+ * "setup" (core/step_phases.h) and "inverse_apply", under which an
+ * implementation registers its own sub-phases. */
+int inv_events(EventId *setup, EventId *apply);
 
 /* The way to use an InvApprox. inv_setup marks it ready on success (not
  * ready on failure); inv_apply refuses (MPM_EINTERNAL) when not ready. */

@@ -3,7 +3,6 @@
 #include "solvers/outer_method.h"
 
 #include <math.h>
-#include <omp.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -32,27 +31,29 @@ int solve_end(SolveStats *st, SolveStatus status, const char *fmt, ...)
     return 1;
 }
 
-int solve_past_deadline(const SolveCtx *c) { return c->set->deadline > 0 && omp_get_wtime() >= c->set->deadline; }
+int solve_past_deadline(const SolveCtx *c) { return deadline_passed(&c->set->deadline); }
 
 void solve_report_iteration(SolveCtx *c, int it, double residual, double E)
 {
-    if (c->hook) c->hook(c->hook_ctx, it, omp_get_wtime() - c->t_start, residual, E);
+    if (c->hook) c->hook(c->hook_ctx, it, event_log_elapsed(c->log, c->phase[STEP_SOLVE]), residual, E);
 }
 
+/* solve_energy and solve_gradient return no status: a refused begin or end
+ * stays in the log, and solver_solve reports it from its snapshot. */
 double solve_energy(SolveCtx *c, const double *dv, SolveStats *st)
 {
-    double t0 = omp_get_wtime();
+    event_log_begin(c->log, c->phase[STEP_LINESEARCH]);
     double E = problem_energy(c->pb, dv);
     st->ls_evals++;
-    st->linesearch_s += omp_get_wtime() - t0;
+    event_log_end(c->log, c->phase[STEP_LINESEARCH]);
     return E;
 }
 
 void solve_gradient(SolveCtx *c, const double *dv, double *g, SolveStats *st)
 {
-    double t0 = omp_get_wtime();
+    event_log_begin(c->log, c->phase[STEP_LINESEARCH]);
     problem_gradient(c->pb, dv, g);
-    st->linesearch_s += omp_get_wtime() - t0;
+    event_log_end(c->log, c->phase[STEP_LINESEARCH]);
 }
 
 double solve_evaluate(SolveCtx *c, const double *dv, double *g, SolveStats *st)
@@ -83,8 +84,7 @@ int solve_should_stop(SolveCtx *c, const double *g, double E, int it, SolveStats
     double res = problem_cn_residual(c->pb, g);
     st->residual = res;
     if (it == 0) c->energy0 = E;
-    double now = omp_get_wtime();
-    if (c->hook) c->hook(c->hook_ctx, it, now - c->t_start, res, E);
+    solve_report_iteration(c, it, res, E);
     if (!isfinite(res) || !isfinite(E))
         return solve_end(st, SOLVE_FAILED, "non-finite %s (%g) at outer iteration %d", isfinite(E) ? "residual" : "energy",
                          isfinite(E) ? res : E, it);
@@ -94,9 +94,9 @@ int solve_should_stop(SolveCtx *c, const double *g, double E, int it, SolveStats
         return 1;
     }
     if (it >= c->set->max_outer) return solve_end(st, SOLVE_CAPPED, "outer iteration cap %d reached", c->set->max_outer);
-    if (c->set->deadline > 0 && now >= c->set->deadline)
+    if (deadline_passed(&c->set->deadline))
         return solve_end(st, SOLVE_TIMEOUT, "time limit %s reached after %d outer iterations",
-                         c->set->deadline_reason ? c->set->deadline_reason : "", it);
+                         deadline_reason(&c->set->deadline), it);
     int progress = 0;
     if (E < c->best_energy) c->best_energy = E, progress = 1;
     if (res < c->best_residual) c->best_residual = res, progress = 1;
@@ -137,27 +137,26 @@ void solve_projection(SolveCtx *c, Projection *P)
     P->ctx = c->pb;
 }
 
-static int assemble(SolveCtx *c, int projected, Bsr *H, double *diag, SolveStats *st)
+static int assemble(SolveCtx *c, int projected, Bsr *H, double *diag)
 {
-    double t0 = omp_get_wtime();
+    int status = event_log_begin(c->log, c->phase[STEP_ASSEMBLE]);
+    if (status) return status;
     /* Assembled: the tangent is used once, by the assembly, unless the
      * inverse rediscretises from the particles' stored tangents (GMG). */
-    int status;
     if (H && !(c->inv->caps & INV_NEEDS_PROBLEM)) status = problem_assemble_fused(c->pb, projected, H);
     else if (!(status = problem_tangent(c->pb, projected)) && H) status = problem_assemble(c->pb, H);
     if (!status) {
         if (H) bsr_diagonal(H, diag);
         else problem_diagonal(c->pb, diag);
     }
-    st->assemble_s += omp_get_wtime() - t0;
-    return status;
+    return event_log_end_with(c->log, c->phase[STEP_ASSEMBLE], status);
 }
 
-int solve_assemble(SolveCtx *c, Bsr *H, double *diag, SolveStats *st) { return assemble(c, 1, H, diag, st); }
+int solve_assemble(SolveCtx *c, Bsr *H, double *diag, SolveStats *st) { return assemble(c, 1, H, diag); }
 
 int solve_assemble_unprojected(SolveCtx *c, Bsr *H, double *diag, SolveStats *st)
 {
-    return assemble(c, 0, H, diag, st);
+    return assemble(c, 0, H, diag);
 }
 
 double solve_gradient_tolerance(const SolveCtx *c) { return c->stop->gradient_tolerance(c->pb, c->stop_tol); }
@@ -165,7 +164,6 @@ double solve_gradient_tolerance(const SolveCtx *c) { return c->stop->gradient_to
 int solve_setup_inverse(SolveCtx *c, const Bsr *H, const double *diag, const LinearOp *op, const Projection *proj,
                         SolveStats *st)
 {
-    double t0 = omp_get_wtime();
     StepProblem *pb = c->pb;
     InvSetupInput in = {
         .n_nodes = pb->n_nodes,
@@ -178,24 +176,22 @@ int solve_setup_inverse(SolveCtx *c, const Bsr *H, const double *diag, const Lin
         .problem = pb,
         .deadline = c->set->deadline,
     };
-    int status = inv_setup(c->inv, &in);
-    st->setup_s += omp_get_wtime() - t0;
-    return status;
+    return inv_setup(c->inv, &in);
 }
 
 int solve_line_search(SolveCtx *c, const double *dv, const double *g, const double *p, double E0, double gTp,
                       double *dv_new, double *g_new, LineSearchOutcome *out, SolveStats *st)
 {
-    double t0 = omp_get_wtime();
+    int status = event_log_begin(c->log, c->phase[STEP_LINESEARCH]);
+    if (status) return status;
     LineSearchParams prm = {c->set->max_halvings};
-    int status = c->ls->search(c->pb, dv, p, E0, g, gTp, &prm, dv_new, g_new, out);
+    status = c->ls->search(c->pb, dv, p, E0, g, gTp, &prm, dv_new, g_new, out);
     st->ls_evals += out->evals;
     if (!status && !out->stalled && out->energy - E0 > st->energy_increase_max)
         st->energy_increase_max = out->energy - E0; /* NaN never enters: a NaN energy fails the next stop test */
     if (!status && out->stalled) solve_end(st, SOLVE_STALLED, "%s", out->why);
     else if (!status && !out->have_gradient) problem_gradient(c->pb, dv_new, g_new);
-    st->linesearch_s += omp_get_wtime() - t0;
-    return status;
+    return event_log_end_with(c->log, c->phase[STEP_LINESEARCH], status);
 }
 
 int solve_take_step(SolveCtx *c, double *dv, double **g, double **g_new, const double *p, double *E, double gTp,

@@ -9,7 +9,10 @@
  * time limit, and the iteration hook. It calls the helpers below so that
  * every method stops, times and counts by the same rules; a method never
  * reads a clock or counts work itself (the way PETSc times KSPSolve and
- * PCApply in the wrapper, not in each implementation):
+ * PCApply in the wrapper, not in each implementation). The wrappers time
+ * the step phases of core/step_phases.h through the solve's event log
+ * (SolveCtx.log), and the deadline is a value of the settings that
+ * deadline_passed() tests:
  *  - solve_should_stop() at the top of every iteration (convergence, the
  *    outer cap, the time limit, stagnation, non-finite values);
  *  - solve_direction_converged() once the iteration's search direction is
@@ -18,9 +21,9 @@
  *  - solve_energy() / solve_gradient() / solve_evaluate(),
  *    solve_assemble(), solve_setup_inverse(), solve_line_search(),
  *    solve_pcg() and solve_minres() for the phases timed and the work
- *    counted in SolveStats; solver_solve() charges the rest of the solve's
- *    wall time (the direction: Krylov solves, the two-loop recursion) to
- *    solve_s.
+ *    counted in SolveStats; solver_solve() times the whole solve as the
+ *    event "solve" and charges its remainder (the direction: Krylov solves,
+ *    the two-loop recursion) to solve_s.
  * Adding an outer method is one new file defining its OuterMethodOps and one
  * line in experiments/run/registry.c; tests/conformance/test_conformance.c then checks it
  * (when it claims OUTER_TO_TOLERANCE: reaches eps, honours the cap with
@@ -33,12 +36,13 @@
  *    (PN's H p = -g; 0 for L-BFGS, which solves none);
  *  - inner_iters: iterations inside the inverse approximation (coarsest-level
  *    PCG of a V-cycle, LBFGS-H's PCG), counted by the solver layer;
- *  - phase timers, together covering the solve: assemble_s (tangent
- *    stiffness, Hessian assembly or matrix-free diagonal), setup_s (inverse
- *    approximation setup), linesearch_s (every energy and gradient
- *    evaluation: the initial point, the line-search trials, the gradient at
- *    the accepted point) and solve_s, the remainder (the direction: PCG,
- *    two-loop recursion, and the stopping tests). */
+ *  - phase timers, together covering the solve, filled from the solve's
+ *    event log (the difference of its snapshots before and after):
+ *    assemble_s (tangent stiffness, Hessian assembly or matrix-free
+ *    diagonal), setup_s (inverse approximation setup), linesearch_s (every
+ *    energy and gradient evaluation: the initial point, the line-search
+ *    trials, the gradient at the accepted point) and solve_s, the remainder
+ *    (the direction: PCG, two-loop recursion, and the stopping tests). */
 #ifndef MPM_OUTER_METHOD_H
 #define MPM_OUTER_METHOD_H
 
@@ -46,7 +50,10 @@
 #include <stdio.h>
 
 #include "core/bsr.h"
+#include "core/deadline.h"
+#include "core/event_log.h"
 #include "core/problem.h"
+#include "core/step_phases.h"
 #include "solvers/inverse_approx.h"
 #include "solvers/krylov/minres.h"
 #include "solvers/krylov/pcg.h"
@@ -63,8 +70,7 @@ typedef struct {
     int max_outer;        /* 10000 */
     int max_linear;       /* 10000: PCG iterations per linear solve */
     int max_halvings;     /* 60 */
-    double deadline;      /* omp_get_wtime() at which the solve stops as timeout; 0 = none */
-    const char *deadline_reason; /* for the status reason, e.g. "--max-step-seconds 5" */
+    Deadline deadline;    /* past it the solve stops as timeout (none: zero-initialised) */
 } SolveSettings;
 
 typedef struct {
@@ -127,8 +133,10 @@ struct SolveCtx {
     const SolveSettings *set;
     IterHook hook;
     void *hook_ctx;
+    EventLog *log;                 /* where the wrappers time the phases (never NULL) */
+    EventId phase[STEP_PHASES];    /* the step phases' events (core/step_phases.h) */
     /* kept by solve_should_stop */
-    double t_start, best_energy, best_residual;
+    double best_energy, best_residual;
     double energy0; /* E at iteration 0 (the decrement rule's E_0) */
     int last_progress;
 };
@@ -140,7 +148,7 @@ struct SolveCtx {
  *   failed    non-finite energy or residual;
  *   converged stop->measure < stop_tol;
  *   capped    it >= max_outer;
- *   timeout   past set->deadline;
+ *   timeout   set->deadline has passed;
  *   stalled   neither the energy nor the residual went below its best value
  *             for stall_iters iterations (an accepted equal energy counts as
  *             no decrease, so a stagnated solve cannot loop forever). */
@@ -154,13 +162,14 @@ int solve_should_stop(SolveCtx *c, const double *g, double E, int it, SolveStats
 int solve_direction_converged(SolveCtx *c, double gTp, double E, SolveStats *st);
 /* 1 when the solve's time limit (set->deadline) has passed. */
 int solve_past_deadline(const SolveCtx *c);
-/* Calls the iteration hook (when set) with the time since the solve began;
+/* Calls the iteration hook (when set) with the time since the solve began
+ * (the open "solve" event of the log);
  * for methods whose iterations do not go through solve_should_stop. */
 void solve_report_iteration(SolveCtx *c, int it, double residual, double E);
-/* E(dv), counted in ls_evals and timed as linesearch_s. */
+/* E(dv), counted in ls_evals and timed in the linesearch phase. */
 double solve_energy(SolveCtx *c, const double *dv, SolveStats *st);
 /* g = grad E(dv) (the cache must hold dv: call after solve_energy at dv),
- * timed as linesearch_s. */
+ * timed in the linesearch phase. */
 void solve_gradient(SolveCtx *c, const double *dv, double *g, SolveStats *st);
 /* Both at dv: returns E(dv), fills g. */
 double solve_evaluate(SolveCtx *c, const double *dv, double *g, SolveStats *st);
@@ -177,7 +186,7 @@ int solve_end(SolveStats *st, SolveStatus status, const char *fmt, ...) __attrib
 void solve_hessian_op(SolveCtx *c, const Bsr *H, LinearOp *op);
 void solve_projection(SolveCtx *c, Projection *P);
 /* Tangent stiffness at the cached iterate, then H (when not NULL) and the 9n
- * diagonal blocks (from H, or matrix-free); timed as assemble_s.
+ * diagonal blocks (from H, or matrix-free); timed in the assemble phase.
  * solve_assemble uses the projected (SPD) tangent of SPEC 3, the one every
  * HOT-study solver sees; solve_assemble_unprojected the true dP/dF, which
  * may be indefinite (Gast et al. 2015's Newton, the semi-implicit method). */
@@ -188,12 +197,13 @@ int solve_assemble_unprojected(SolveCtx *c, Bsr *H, double *diag, SolveStats *st
  * tolerance for "l2", and for the CN rule its L2 equivalent problem_tau(pb,
  * eps) (SPEC 4; the HOT code's newton.tolerance with --usecn). */
 double solve_gradient_tolerance(const SolveCtx *c);
-/* Sets the inverse approximation up at the current tangent; timed as setup_s. */
+/* Sets the inverse approximation up at the current tangent, handing it the
+ * solve's deadline; inv_setup times it in the setup phase. */
 int solve_setup_inverse(SolveCtx *c, const Bsr *H, const double *diag, const LinearOp *op, const Projection *proj,
                         SolveStats *st);
 /* The line-search strategy from dv along p, then the gradient at the
  * accepted point into g_new (unless the strategy gave it); everything timed
- * as linesearch_s. When it stalls: st->status stalled with the strategy's
+ * in the linesearch phase. When it stalls: st->status stalled with the strategy's
  * reason, the cache left at dv. */
 int solve_line_search(SolveCtx *c, const double *dv, const double *g, const double *p, double E0, double gTp,
                       double *dv_new, double *g_new, LineSearchOutcome *out, SolveStats *st);

@@ -1,7 +1,6 @@
 #include "solvers/solver.h"
 
 #include <math.h>
-#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -38,7 +37,7 @@ int solver_create(const char *name, const OuterMethodOps *outer, const InvApprox
     if (!s) return mpm_error(MPM_EINTERNAL, "out of memory creating solver %s", name);
     snprintf(s->name, sizeof s->name, "%s", name);
     if (opts) s->opts = *opts;
-    int st = MPM_OK;
+    int st = step_phases_register(s->phase);
     const char *ls = solver_opt_string(&s->opts, "linesearch", "halving");
     const char *stop = solver_opt_string(&s->opts, "stop", "cn");
     s->stall_iters = solver_opt_int(&s->opts, "stall_iters", 20, 1, 1000000, &st);
@@ -69,10 +68,14 @@ int solver_create(const char *name, const OuterMethodOps *outer, const InvApprox
     return MPM_OK;
 }
 
-int solver_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv, SolveStats *st, IterHook hook,
-                 void *hook_ctx)
+int solver_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv, SolveStats *st, EventLog *log,
+                 IterHook hook, void *hook_ctx)
 {
     memset(st, 0, sizeof *st);
+    if (!log) log = &s->log;
+    EventTotals before, after;
+    int status = event_log_snapshot(log, &before);
+    if (status) return status;
     SolveCtx c = {
         .pb = pb,
         .inv = s->inv,
@@ -83,18 +86,29 @@ int solver_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *d
         .set = set,
         .hook = hook,
         .hook_ctx = hook_ctx,
-        .t_start = omp_get_wtime(),
+        .log = log,
         .best_energy = INFINITY,
         .best_residual = INFINITY,
     };
+    memcpy(c.phase, s->phase, sizeof c.phase);
+    if ((status = event_log_begin(log, s->phase[STEP_SOLVE]))) return status;
+    EventLog *inv_log = s->inv->log; /* the inverse approximation times into this solve's log */
+    s->inv->log = log;
     long inner0 = inv_inner_iters(s->inv);
     inv_begin_solve(s->inv);
-    int status = s->outer->ops->solve(s->outer, &c, dv, st);
+    status = s->outer->ops->solve(s->outer, &c, dv, st);
     st->inner_iters = inv_inner_iters(s->inv) - inner0;
+    s->inv->log = inv_log;
+    int log_status = event_log_end(log, s->phase[STEP_SOLVE]);
+    int snapshot_status = event_log_snapshot(log, &after);
+    if (!log_status) log_status = snapshot_status;
+    event_totals_since(&after, &before, &after);
+    st->assemble_s = step_phase_seconds(&after, s->phase, STEP_ASSEMBLE);
+    st->setup_s = step_phase_seconds(&after, s->phase, STEP_SETUP);
+    st->linesearch_s = step_phase_seconds(&after, s->phase, STEP_LINESEARCH);
     /* the direction (Krylov solves, two-loop recursion) and the stopping
-     * tests: what the timed phases of the wrappers did not cover */
-    double rest = omp_get_wtime() - c.t_start - st->assemble_s - st->setup_s - st->linesearch_s;
-    st->solve_s = rest > 0.0 ? rest : 0.0;
+     * tests: the solve less the phases above */
+    st->solve_s = step_phase_seconds(&after, s->phase, STEP_SOLVE);
     if (status == MPM_ENUMERIC) {
         /* a breakdown of this step, not of the program: the step's status */
         st->status = SOLVE_FAILED;
@@ -102,7 +116,19 @@ int solver_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *d
         mpm_clear_error();
         status = MPM_OK;
     }
-    return status;
+    return status ? status : log_status;
+}
+
+/* The events under `parent` with calls in t, in registration order, each
+ * followed by its own sub-events one level deeper. */
+static void print_events(FILE *f, const EventTotals *t, EventId parent, int depth)
+{
+    for (EventId e = 0; e < event_count(); ++e) {
+        if (event_parent(e) != parent || t->event[e].calls == 0) continue;
+        fprintf(f, "  %*s%-*s %10.4f s %8ld calls\n", 2 * depth, "", 28 - 2 * depth, event_name(e),
+                t->event[e].seconds, t->event[e].calls);
+        print_events(f, t, e, depth + 1);
+    }
 }
 
 void solver_view(const Solver *s, FILE *f, InvView *inv_view_out)
@@ -115,6 +141,13 @@ void solver_view(const Solver *s, FILE *f, InvView *inv_view_out)
         if (s->outer->ops->view) s->outer->ops->view(s->outer, f);
     }
     inv_view(s->inv, f, inv_view_out);
+    if (!f) return;
+    const EventTotals *t = &s->log.totals;
+    int any = 0;
+    for (EventId e = 0; e < event_count(); ++e) any |= t->event[e].calls > 0;
+    if (!any) return;
+    fprintf(f, "events of the solver's own log (seconds over every solve; a sub-phase under its phase):\n");
+    print_events(f, t, EVENT_NONE, 0);
 }
 
 void solver_destroy(Solver *s)

@@ -7,6 +7,8 @@
 
 #include <float.h>
 
+#include "core/event_log.h"
+#include "core/step_phases.h"
 #include "solvers/inverse_approx.h"
 #include "solvers/outer_method.h"
 
@@ -33,6 +35,9 @@ typedef struct Solver {
     double stop_tol;            /* NAN: the run's eps (rule "cn") */
     int stall_iters;
     SolverOptions opts;         /* every option consulted, with the value in effect */
+    EventId phase[STEP_PHASES]; /* the step phases' events, registered by solver_create */
+    EventLog log;               /* the solver's own event log: solver_solve times into it when
+                                   not handed one; solver_view prints it */
 } Solver;
 
 /* Creates outer x inverse with the options (consumed: a key no part reads is
@@ -45,11 +50,19 @@ int solver_create(const char *name, const OuterMethodOps *outer, const InvApprox
 /* Minimises the step problem from dv (in: initial guess, out: the last
  * accepted iterate). A numerical breakdown inside (MPM_ENUMERIC) becomes
  * st->status failed with the message as st->reason and returns MPM_OK; other
- * errors are returned. */
-int solver_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv, SolveStats *st, IterHook hook,
-                 void *hook_ctx);
-/* Prints the composition and the parts' views to f (when not NULL) and
- * returns the inverse approximation's view (when not NULL). */
+ * errors are returned.
+ *
+ * Timing: the solve and its phases (core/step_phases.h: solve, assemble,
+ * setup, linesearch; and the inverse approximation's apply and its
+ * sub-phases, e.g. multigrid's) are events of `log`, which the solver uses
+ * only during the call; NULL: the solver's own (s->log). A caller that
+ * times a whole step hands its log here and times P2G and G2P into the same
+ * one. st's phase timers are this solve's difference of the log. */
+int solver_solve(Solver *s, StepProblem *pb, const SolveSettings *set, double *dv, SolveStats *st, EventLog *log,
+                 IterHook hook, void *hook_ctx);
+/* Prints the composition, the parts' views and the events of the solver's
+ * own log to f (when not NULL) and returns the inverse approximation's view
+ * (when not NULL). */
 void solver_view(const Solver *s, FILE *f, InvView *inv_view);
 void solver_destroy(Solver *s);
 

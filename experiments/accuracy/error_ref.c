@@ -182,7 +182,7 @@ int error_ref_measure(void *ctx, StepProblem *pb, const double *dv)
     problem_initial_guess(pb, r->dv0);
     vec_copy(len, r->dv0, r->dvs);
     SolveStats rs;
-    if ((st = solver_solve(ref, pb, &r->set, r->dvs, &rs, NULL, NULL))) return st;
+    if ((st = solver_solve(ref, pb, &r->set, r->dvs, &rs, NULL, NULL, NULL))) return st;
     if (rs.status == SOLVE_FAILED && ref == r->exact) {
         /* a factorisation that broke down on round-off (tiny-mass nodes beside stiff ones): the
          * iterative reference instead, and one line saying so */
@@ -191,7 +191,7 @@ int error_ref_measure(void *ctx, StepProblem *pb, const double *dv)
         ref = r->fallback;
         r->last.ref_solver = r->fallback_name;
         vec_copy(len, r->dv0, r->dvs);
-        if ((st = solver_solve(ref, pb, &r->set, r->dvs, &rs, NULL, NULL))) return st;
+        if ((st = solver_solve(ref, pb, &r->set, r->dvs, &rs, NULL, NULL, NULL))) return st;
     }
     r->last.valid = 1;
     r->last.ref_status = rs.status;

@@ -28,16 +28,15 @@ static int worse(int a, int b) { return a > b ? a : b; } /* SolveStatus is order
 /* The deadline of the next solve: the earlier of the step's and the run's. */
 static void set_deadline(const FrameDriver *d, double run_t0, SolveSettings *set, char *why, size_t len)
 {
-    double now = omp_get_wtime();
-    set->deadline = 0.0;
-    set->deadline_reason = why;
+    set->deadline = (Deadline){.reason = why};
     why[0] = '\0';
     if (d->max_step_s > 0) {
-        set->deadline = now + d->max_step_s;
+        set->deadline = deadline_in(d->max_step_s, why);
         snprintf(why, len, "--max-step-seconds %g", d->max_step_s);
     }
-    if (d->max_run_s > 0 && (set->deadline == 0.0 || run_t0 + d->max_run_s < set->deadline)) {
-        set->deadline = run_t0 + d->max_run_s;
+    /* run_t0 is on OpenMP's wall clock, the one of deadlines (event_clock) */
+    if (d->max_run_s > 0 && (!set->deadline.active || run_t0 + d->max_run_s < set->deadline.at)) {
+        set->deadline = (Deadline){.active = 1, .at = run_t0 + d->max_run_s, .reason = why};
         snprintf(why, len, "--max-run-seconds %g", d->max_run_s);
     }
 }

@@ -50,7 +50,7 @@ int time_step_run(Simulation *sim, Solver *solver, const SolveSettings *set, Ste
     info->active_nodes = n;
     if ((status = reserve(w, n))) return status;
     problem_initial_guess(&sim->pb, w->dv);
-    if ((status = solver_solve(solver, &sim->pb, set, w->dv, ss, hook, hook_ctx))) return status;
+    if ((status = solver_solve(solver, &sim->pb, set, w->dv, ss, NULL, hook, hook_ctx))) return status;
     double t2 = omp_get_wtime();
     if (ss->status != SOLVE_FAILED || apply_failed) {
         if (w->after_solve) {

@@ -16,7 +16,7 @@ typedef struct {
     PcgWork work;
     double *z;
     int cap, n, max_iters;
-    double deadline;                 /* InvSetupInput.deadline of the last setup */
+    Deadline deadline;               /* InvSetupInput.deadline of the last setup */
     long applies, capped, timed_out; /* since the last setup */
 } InexactPcg;
 

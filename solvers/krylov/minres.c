@@ -18,7 +18,6 @@
 #include "solvers/krylov/minres.h"
 
 #include <math.h>
-#include <omp.h>
 #include <stdlib.h>
 
 #include "core/error.h"
@@ -94,7 +93,7 @@ int minres_solve(const LinearOp *A, InvApprox *M, const Projection *proj, const 
             res->capped = 1;
             break;
         }
-        if (opt->deadline > 0 && omp_get_wtime() >= opt->deadline) {
+        if (deadline_passed(&opt->deadline)) {
             res->timed_out = 1;
             break;
         }

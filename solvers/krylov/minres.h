@@ -21,7 +21,7 @@
 typedef struct {
     double rel_tol;
     int max_iters;
-    double deadline; /* omp_get_wtime() after which no iteration starts; 0 = none */
+    Deadline deadline; /* past it no iteration starts (zero-initialised: none) */
 } MinresOptions;
 
 typedef struct {

@@ -31,7 +31,6 @@
 #include "solvers/krylov/pcg.h"
 
 #include <math.h>
-#include <omp.h>
 #include <stdlib.h>
 
 #include "core/error.h"
@@ -128,7 +127,7 @@ int pcg_solve(const LinearOp *A, InvApprox *M, const Projection *proj, const dou
             res->capped = 1;
             break;
         }
-        if (opt->deadline > 0 && omp_get_wtime() >= opt->deadline) {
+        if (deadline_passed(&opt->deadline)) {
             res->timed_out = 1;
             break;
         }

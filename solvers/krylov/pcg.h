@@ -11,7 +11,7 @@
  *  - PCG_RELATIVE_L2: stop when the unpreconditioned ||r||_2 < rel_tol ||r0||_2
  *    (Gast et al. 2015 §3.1: "solving the system to a relative tolerance").
  * The check is at the top of each iteration; at most max_iters iterations,
- * and none after `deadline` (omp_get_wtime(); 0 = none: timed_out is set).
+ * and none once `deadline` has passed (timed_out is set).
  * Vectors r, z and the search direction are kept in the projected subspace.
  * A variable preconditioner (InvApprox.flexible) gets flexible CG's beta.
  * Non-positive curvature of A along a search direction ends the solve as
@@ -32,7 +32,7 @@ typedef struct {
     double tau;      /* PCG_FORCING floor */
     double abs_tol;  /* PCG_ABSOLUTE */
     int max_iters;   /* 10000 in every reference configuration */
-    double deadline; /* omp_get_wtime() after which no iteration starts; 0 = none */
+    Deadline deadline; /* past it no iteration starts (zero-initialised: none) */
     double rel_tol;  /* PCG_RELATIVE, PCG_RELATIVE_L2 */
 } PcgOptions;
 

@@ -3,7 +3,7 @@
 #include "solvers/mg/mg.h"
 
 #include <math.h>
-#include <omp.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -17,7 +17,7 @@
 #include "solvers/inverse/sgs.h"
 
 /* What the view op reports: the hierarchy of the last setup and the work
- * done by V-cycles since. */
+ * done by V-cycles since. (The time of each part is in the event log.) */
 typedef struct {
     int n_levels;
     int embedding;                     /* MgEmbedding */
@@ -26,12 +26,20 @@ typedef struct {
     int64_t nnzb[MG_MAX_LEVELS];       /* stored blocks per level */
     double avg_row[MG_MAX_LEVELS];     /* nonzero blocks per row, mean */
     int max_row[MG_MAX_LEVELS];        /* and max */
-    double transfer_s, galerkin_s, diag_s; /* parts of the last setup (its whole time: InvStats) */
-    double single_s;                   /* single-precision copies (smoother_precision=single) */
     long vcycles, coarse_iters, coarse_capped; /* since the last setup */
-    double smooth_s[MG_MAX_LEVELS];    /* apply time split, since the last setup */
-    double transfer_apply_s, coarse_s;
 } MgInfo;
+
+/* The sub-phases, events of the log the wrappers time setup and apply in
+ * (InvApprox.log), registered by mg_create. */
+typedef struct {
+    EventId transfers;    /* setup: transfer operators (GMG: also the rediscretised levels) */
+    EventId galerkin;     /* setup: Galerkin products R A P */
+    EventId diagonal;     /* setup: coarse colourings, block diagonals and their inverses */
+    EventId single;       /* setup: single-precision matrix copies (smoother_precision=single) */
+    EventId transfer_apply;            /* apply: restrictions, prolongations, their residual updates */
+    EventId coarse;                    /* apply: the coarsest level's PCG */
+    EventId smooth[MG_MAX_LEVELS - 1]; /* apply: the smoothing of each level but the coarsest */
+} MgEvents;
 
 typedef struct {
     int n;
@@ -69,6 +77,7 @@ typedef struct {
     MgGalerkinWork *gw;
     CoarseJacobi cj;
     MgInfo info;
+    MgEvents ev;
     int rediscretize;            /* baseline GMG: coarse levels from particles */
     int gmg_bc_project;          /* GMG only: project coarse residuals at coarse Dirichlet nodes */
     GmgLevel gl[MG_MAX_LEVELS];  /* their particle copies and grids */
@@ -105,6 +114,25 @@ static int level_reserve(MgLevel *L, int n, int own_diag)
     return MPM_OK;
 }
 
+static int register_events(int levels, MgEvents *ev)
+{
+    EventId setup, apply;
+    int st = inv_events(&setup, &apply);
+    if (!st) st = event_register("mg_transfers", setup, &ev->transfers);
+    if (!st) st = event_register("mg_galerkin", setup, &ev->galerkin);
+    if (!st) st = event_register("mg_diagonal", setup, &ev->diagonal);
+    if (!st) st = event_register("mg_single", setup, &ev->single);
+    if (!st) st = event_register("mg_transfer_apply", apply, &ev->transfer_apply);
+    if (!st) st = event_register("mg_coarse", apply, &ev->coarse);
+    for (int l = 0; l < MG_MAX_LEVELS - 1; ++l) ev->smooth[l] = EVENT_NONE;
+    for (int l = 0; l + 1 < levels && !st; ++l) {
+        char name[EVENT_NAME_MAX + 1];
+        snprintf(name, sizeof name, "mg_smooth_l%d", l);
+        st = event_register(name, apply, &ev->smooth[l]);
+    }
+    return st;
+}
+
 static int mg_create(SolverOptions *opt, InvApprox **out)
 {
     int st = MPM_OK;
@@ -134,8 +162,11 @@ static int mg_create(SolverOptions *opt, InvApprox **out)
     }
     if (st) return st;
     if (!(ctol > 0 && ctol < 1)) return mpm_error(MPM_EINPUT, "solver option coarse_tol=%g: expected 0 < tol < 1", ctol);
+    MgEvents ev;
+    if ((st = register_events(levels, &ev))) return st;
     Mg *M = calloc(1, sizeof *M);
     if (!M) return mpm_error(MPM_EINTERNAL, "out of memory: multigrid");
+    M->ev = ev;
     M->base.ops = &inv_mg_ops;
     M->kind = kind;
     M->rediscretize = rediscretize;
@@ -175,17 +206,22 @@ static void fill_level_info(Mg *M, int l)
 /* smoother_precision=single: the single-precision values of levels
  * from..nlev-2 (the coarsest level does not smooth: its PCG reads the
  * doubles). Called whenever such a level's matrix changes. */
-static int single_copies(Mg *M, int from)
+static int copy_single(Mg *M, int from)
 {
-    if (!M->single) return MPM_OK;
-    double t0 = omp_get_wtime();
     for (int l = from; l < M->nlev - 1; ++l) {
         MgLevel *L = &M->lev[l];
         int st = bsr_values_single(L->A, &L->valf, &L->capf);
         if (st) return st;
     }
-    M->info.single_s += omp_get_wtime() - t0;
     return MPM_OK;
+}
+
+static int single_copies(Mg *M, int from)
+{
+    if (!M->single) return MPM_OK;
+    int st = event_log_begin(M->base.log, M->ev.single);
+    if (!st) st = event_log_end_with(M->base.log, M->ev.single, copy_single(M, from));
+    return st;
 }
 
 /* r -= A x on level l, with the matrix the smoother reads */
@@ -196,25 +232,45 @@ static void level_residual(const Mg *M, int l, const double *x, double *r)
     else bsr_spmv_sub(L->A, x, r);
 }
 
+/* The inverse of level l's diagonal blocks. */
+static int invert_diagonal(MgLevel *L, int l)
+{
+    char what[32];
+    snprintf(what, sizeof what, "multigrid level %d", l);
+    return block_diag_invert(L->n, L->diag, L->dinv, what);
+}
+
+/* Coarse level l's diagonal blocks from its matrix, and their inverse. */
+static int coarse_diagonal(MgLevel *C, int l)
+{
+    bsr_diagonal(C->A, C->diagown);
+    C->diag = C->diagown;
+    return invert_diagonal(C, l);
+}
+
 /* Galerkin products and block-diagonal inverses of levels from..nlev-1
  * (level `from` >= 1 gets A from the finer level's A), on the kept
  * transfers, coarse node sets and colourings. */
 static int mg_galerkin_levels(Mg *M, int from)
 {
+    EventLog *log = M->base.log;
     for (int l = from; l < M->nlev; ++l) {
         MgLevel *F = &M->lev[l - 1], *C = &M->lev[l];
-        double tb = omp_get_wtime();
-        int st = mg_galerkin(F->A, &F->T, &C->Aown, &M->gw);
+        int st = event_log_begin(log, M->ev.galerkin);
+        if (!st) st = event_log_end_with(log, M->ev.galerkin, mg_galerkin(F->A, &F->T, &C->Aown, &M->gw));
+        if (!st && !(st = event_log_begin(log, M->ev.diagonal)))
+            st = event_log_end_with(log, M->ev.diagonal, coarse_diagonal(C, l));
         if (st) return st;
-        double tc = omp_get_wtime();
-        M->info.galerkin_s += tc - tb;
-        bsr_diagonal(C->A, C->diagown);
-        char what[32];
-        snprintf(what, sizeof what, "multigrid level %d", l);
-        if ((st = block_diag_invert(C->n, C->diag, C->dinv, what))) return st;
-        M->info.diag_s += omp_get_wtime() - tc;
     }
     return MPM_OK;
+}
+
+/* Level 0's diagonal inverse, timed as a diagonal. */
+static int fine_diagonal(Mg *M)
+{
+    int st = event_log_begin(M->base.log, M->ev.diagonal);
+    if (!st) st = event_log_end_with(M->base.log, M->ev.diagonal, invert_diagonal(&M->lev[0], 0));
+    return st;
 }
 
 /* Setup reuse (inverse_approx.h): the same fine nodes and pattern. The fine
@@ -235,9 +291,7 @@ static int mg_reuse(InvApprox *self, const InvSetupInput *in, int values, int *r
     L0->coord = in->coord;
     L0->col = in->coloring;
     L0->diag = in->diag;
-    double td = omp_get_wtime();
-    int st = block_diag_invert(L0->n, L0->diag, L0->dinv, "multigrid level 0");
-    M->info.diag_s += omp_get_wtime() - td;
+    int st = fine_diagonal(M);
     if (st) return st;
     if (values && !M->rediscretize && M->nlev > 1) {
         if ((st = mg_galerkin_levels(M, 1))) return st;
@@ -246,17 +300,29 @@ static int mg_reuse(InvApprox *self, const InvSetupInput *in, int values, int *r
         return single_copies(M, 0);
     }
     /* the fine level has the new H; the coarser copies are kept with their levels */
-    if (M->single && M->nlev > 1) {
-        double t0 = omp_get_wtime();
-        st = bsr_values_single(L0->A, &L0->valf, &L0->capf);
-        M->info.single_s += omp_get_wtime() - t0;
-    }
+    if (M->single && M->nlev > 1 && !(st = event_log_begin(self->log, M->ev.single)))
+        st = event_log_end_with(self->log, M->ev.single, bsr_values_single(L0->A, &L0->valf, &L0->capf));
+    return st;
+}
+
+/* The transfer from level nl-1 to a new level nl: onto a rediscretised
+ * grid (baseline GMG: the level's own grid and Hessian from the particles
+ * at spacing 2^nl dx, linear transfers onto it), or the embedding's. */
+static int build_transfer(Mg *M, const InvSetupInput *in, int nl)
+{
+    MgLevel *F = &M->lev[nl - 1], *C = &M->lev[nl];
+    if (!M->rediscretize) return mg_transfer_build(&F->T, M->kind, F->coord, F->n);
+    if (!in->problem) return mpm_error(MPM_EINTERNAL, "geometric multigrid needs the step problem");
+    double h = in->problem->dx * (double)(1 << nl);
+    int st = gmg_level_build(&M->gl[nl], in->problem, h, &C->Aown);
+    if (!st) st = gmg_transfer_onto(&F->T, F->coord, F->n, &M->gl[nl].grid);
     return st;
 }
 
 static int mg_setup(InvApprox *self, const InvSetupInput *in)
 {
     Mg *M = (Mg *)self;
+    EventLog *log = self->log;
     self->stats = (InvStats){0};
     memset(&M->info, 0, sizeof M->info);
     M->info.embedding = (int)M->kind;
@@ -277,42 +343,28 @@ static int mg_setup(InvApprox *self, const InvSetupInput *in)
     L0->coord = in->coord;
     L0->col = in->coloring;
     L0->diag = in->diag;
-    double td = omp_get_wtime();
-    if ((st = block_diag_invert(L0->n, L0->diag, L0->dinv, "multigrid level 0"))) return st;
-    M->info.diag_s += omp_get_wtime() - td;
+    if ((st = fine_diagonal(M))) return st;
     int nl = 1;
     while (nl < M->max_levels && M->lev[nl - 1].n >= M->min_coarse) {
         MgLevel *F = &M->lev[nl - 1], *C = &M->lev[nl];
-        double ta = omp_get_wtime();
-        if (M->rediscretize) {
-            /* baseline GMG: the level's own grid and Hessian from the
-             * particles at spacing 2^l dx, linear transfers onto it */
-            if (!in->problem) return mpm_error(MPM_EINTERNAL, "geometric multigrid needs the step problem");
-            double h = in->problem->dx * (double)(1 << nl);
-            if ((st = gmg_level_build(&M->gl[nl], in->problem, h, &C->Aown))) return st;
-            if ((st = gmg_transfer_onto(&F->T, F->coord, F->n, &M->gl[nl].grid))) return st;
-        } else if ((st = mg_transfer_build(&F->T, M->kind, F->coord, F->n))) {
-            return st;
-        }
-        double tb = omp_get_wtime();
-        M->info.transfer_s += tb - ta;
+        if (!(st = event_log_begin(log, M->ev.transfers)))
+            st = event_log_end_with(log, M->ev.transfers, build_transfer(M, in, nl));
+        if (st) return st;
         int m = F->T.n_coarse;
         if (m == 0 || m >= F->n) break; /* no coarsening possible */
         if ((st = level_reserve(C, m, 1))) return st;
         C->n = m;
         C->coord = F->T.coarse_coord;
-        if (!M->rediscretize && (st = mg_galerkin(F->A, &F->T, &C->Aown, &M->gw))) return st;
+        if (!M->rediscretize && !(st = event_log_begin(log, M->ev.galerkin)))
+            st = event_log_end_with(log, M->ev.galerkin, mg_galerkin(F->A, &F->T, &C->Aown, &M->gw));
+        if (st) return st;
         C->A = &C->Aown;
-        double tc = omp_get_wtime();
-        M->info.galerkin_s += tc - tb;
-        if ((st = node_coloring_build(C->coord, m, &C->colown))) return st;
-        C->col = &C->colown;
-        bsr_diagonal(C->A, C->diagown);
-        C->diag = C->diagown;
-        char what[32];
-        snprintf(what, sizeof what, "multigrid level %d", nl);
-        if ((st = block_diag_invert(m, C->diag, C->dinv, what))) return st;
-        M->info.diag_s += omp_get_wtime() - tc;
+        if (!(st = event_log_begin(log, M->ev.diagonal))) {
+            int built = node_coloring_build(C->coord, m, &C->colown);
+            if (!built) C->col = &C->colown;
+            st = event_log_end_with(log, M->ev.diagonal, built ? built : coarse_diagonal(C, nl));
+        }
+        if (st) return st;
         ++nl;
     }
     M->nlev = nl;
@@ -352,21 +404,49 @@ static void restrict_level(const Mg *M, int l, const double *fine, double *coars
     if (M->gmg_bc_project) problem_project(&M->gl[l + 1].pb, coarse);
 }
 
+/* Level l on the way down: smooth from u = 0, restrict the residual. */
+static int descend(Mg *M, int l)
+{
+    EventLog *log = M->base.log;
+    MgLevel *L = &M->lev[l];
+    int st = event_log_begin(log, M->ev.smooth[l]);
+    if (st) return st;
+    smooth(M, l, 1, 1);
+    if ((st = event_log_end(log, M->ev.smooth[l])) || (st = event_log_begin(log, M->ev.transfer_apply))) return st;
+    restrict_level(M, l, L->r, M->lev[l + 1].r);
+    return event_log_end(log, M->ev.transfer_apply);
+}
+
+/* Level l on the way up: prolong and add the coarse correction, smooth. */
+static int ascend(Mg *M, int l)
+{
+    EventLog *log = M->base.log;
+    MgLevel *L = &M->lev[l];
+    int st = event_log_begin(log, M->ev.transfer_apply);
+    if (st) return st;
+    mg_prolong(&L->T, M->lev[l + 1].u, L->d);
+    vec_axpy(3 * (size_t)L->n, 1.0, L->d, L->u);
+    level_residual(M, l, L->d, L->r);
+    if ((st = event_log_end(log, M->ev.transfer_apply)) || (st = event_log_begin(log, M->ev.smooth[l]))) return st;
+    smooth(M, l, 0, 0);
+    return event_log_end(log, M->ev.smooth[l]);
+}
+
 static int mg_apply(InvApprox *self, const double *in, double *out)
 {
     Mg *M = (Mg *)self;
     if (M->nlev == 0) return mpm_error(MPM_EINTERNAL, "multigrid applied before setup");
+    EventLog *log = self->log;
     const int nl = M->nlev;
     const int c = nl - 1;
     MgLevel *Lc = &M->lev[c];
     const size_t lenc = 3 * (size_t)Lc->n;
     PcgResult res;
-    int st;
-
 
     /* tolerance of the coarse solve from the input restricted straight down
      * (reference §5.3): coarse_tol * sqrt(bbar^T D^-1 bbar) */
-    double t0 = omp_get_wtime();
+    int st = event_log_begin(log, M->ev.transfer_apply);
+    if (st) return st;
     const double *bbar = in;
     for (int l = 0; l < c; ++l) {
         restrict_level(M, l, bbar, M->lev[l + 1].d);
@@ -376,41 +456,23 @@ static int mg_apply(InvApprox *self, const double *in, double *out)
     double bnorm2 = vec_dot(lenc, bbar, Lc->work);
     PcgOptions po = {.stop = PCG_ABSOLUTE, .abs_tol = M->coarse_tol * sqrt(fmax(bnorm2, 0.0)),
                      .max_iters = M->coarse_max_iters};
-    M->info.transfer_apply_s += omp_get_wtime() - t0;
+    if ((st = event_log_end(log, M->ev.transfer_apply))) return st;
 
     /* down: smooth, restrict the residual (nothing with a single level) */
     vec_copy(3 * (size_t)M->lev[0].n, in, M->lev[0].r);
-    for (int l = 0; l < c; ++l) {
-        MgLevel *L = &M->lev[l];
-        t0 = omp_get_wtime();
-        smooth(M, l, 1, 1);
-        double t1 = omp_get_wtime();
-        restrict_level(M, l, L->r, M->lev[l + 1].r);
-        M->info.smooth_s[l] += t1 - t0;
-        M->info.transfer_apply_s += omp_get_wtime() - t1;
-    }
+    for (int l = 0; l < c; ++l)
+        if ((st = descend(M, l))) return st;
     /* coarsest: block-Jacobi PCG; on the finest level (a one-level
      * hierarchy) with the input's Dirichlet projection, coarser levels carry
      * their BCs in R A P */
     LinearOp op = {.n_nodes = Lc->n, .apply = level_spmv, .ctx = Lc->A};
-    t0 = omp_get_wtime();
-    st = pcg_solve(&op, &M->cj.base, c == 0 ? M->proj : NULL, Lc->r, Lc->u, &po, &M->pw, &res);
-    M->info.coarse_s += omp_get_wtime() - t0;
+    if (!(st = event_log_begin(log, M->ev.coarse)))
+        st = event_log_end_with(log, M->ev.coarse,
+                                pcg_solve(&op, &M->cj.base, c == 0 ? M->proj : NULL, Lc->r, Lc->u, &po, &M->pw, &res));
     /* up: prolong and correct, smooth */
-    for (int l = c - 1; l >= 0 && !st; --l) {
-        MgLevel *L = &M->lev[l];
-        const size_t len = 3 * (size_t)L->n;
-        t0 = omp_get_wtime();
-        mg_prolong(&L->T, M->lev[l + 1].u, L->d);
-        vec_axpy(len, 1.0, L->d, L->u);
-        level_residual(M, l, L->d, L->r);
-        double t1 = omp_get_wtime();
-        smooth(M, l, 0, 0);
-        M->info.transfer_apply_s += t1 - t0;
-        M->info.smooth_s[l] += omp_get_wtime() - t1;
-    }
-    if (!st) vec_copy(3 * (size_t)M->lev[0].n, M->lev[0].u, out);
+    for (int l = c - 1; l >= 0 && !st; --l) st = ascend(M, l);
     if (st) return st;
+    vec_copy(3 * (size_t)M->lev[0].n, M->lev[0].u, out);
     self->stats.inner_iters += res.iters;
     M->info.coarse_iters += res.iters;
     M->info.coarse_capped += res.capped;
@@ -446,20 +508,17 @@ static void mg_view(const InvApprox *self, FILE *f, InvView *out)
     const Mg *M = (const Mg *)self;
     const MgInfo *info = &M->info;
     if (f) {
-        fprintf(f, "multigrid (%s): %d levels, setup %.4f s (transfer %.4f, galerkin %.4f, diagonal %.4f)\n",
+        fprintf(f, "multigrid (%s): %d levels, setup %.4f s (its parts and the V-cycle's: the events mg_*)\n",
                 info->rediscretized ? "geometric, rediscretised from particles"
                 : info->embedding == MG_EMBED_LINEAR ? "linear embedding" : "quadratic embedding",
-                info->n_levels, self->stats.setup_s, info->transfer_s, info->galerkin_s, info->diag_s);
-        if (M->single) fprintf(f, "  smoother_precision=single: single-precision copies %.4f s\n", info->single_s);
+                info->n_levels, self->stats.setup_s);
+        if (M->single) fprintf(f, "  smoother_precision=single: single-precision copies of the smoothed levels\n");
         for (int l = 0; l < info->n_levels; ++l)
-            fprintf(f, "  level %d: %8d nodes %10lld blocks  blocks/row avg %6.1f max %4d  smooth %.4f s\n", l,
-                    info->n[l], (long long)info->nnzb[l], info->avg_row[l], info->max_row[l], info->smooth_s[l]);
+            fprintf(f, "  level %d: %8d nodes %10lld blocks  blocks/row avg %6.1f max %4d\n", l, info->n[l],
+                    (long long)info->nnzb[l], info->avg_row[l], info->max_row[l]);
         if (info->vcycles)
-            fprintf(f,
-                    "  %ld V-cycles: coarse PCG %ld iterations (%.1f per cycle, %ld capped), coarse %.4f s, transfers "
-                    "%.4f s\n",
-                    info->vcycles, info->coarse_iters, (double)info->coarse_iters / info->vcycles, info->coarse_capped,
-                    info->coarse_s, info->transfer_apply_s);
+            fprintf(f, "  %ld V-cycles: coarse PCG %ld iterations (%.1f per cycle, %ld capped)\n", info->vcycles,
+                    info->coarse_iters, (double)info->coarse_iters / info->vcycles, info->coarse_capped);
     }
     if (!out) return;
     out->n_levels = info->n_levels < INV_VIEW_MAX_LEVELS ? info->n_levels : INV_VIEW_MAX_LEVELS;

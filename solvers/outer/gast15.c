@@ -199,7 +199,7 @@ static int gast15_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *
         status = solve_pcg(c, &op, &proj, s->rhs, s->p, &po, &s->pcg, &pr, st);
         if (!status && pr.timed_out) {
             solve_end(st, SOLVE_TIMEOUT, "time limit %s reached in CG at outer iteration %d",
-                      c->set->deadline_reason ? c->set->deadline_reason : "", it);
+                      deadline_reason(&c->set->deadline), it);
             break;
         }
         if (status) return status;

@@ -85,7 +85,7 @@ static int pn_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *st)
         if (status) return status;
         if (pr.timed_out) {
             solve_end(st, SOLVE_TIMEOUT, "time limit %s reached in PCG at outer iteration %d",
-                      c->set->deadline_reason ? c->set->deadline_reason : "", it);
+                      deadline_reason(&c->set->deadline), it);
             break;
         }
 

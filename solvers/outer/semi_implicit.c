@@ -104,7 +104,7 @@ static int si_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *st)
     }
     if (solve_past_deadline(c)) {
         solve_end(st, SOLVE_TIMEOUT, "time limit %s reached before the linear solve",
-                  c->set->deadline_reason ? c->set->deadline_reason : "");
+                  deadline_reason(&c->set->deadline));
         return MPM_OK;
     }
     st->outer_iters = 1;
@@ -116,7 +116,7 @@ static int si_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *st)
     if ((status = solve_setup_inverse(c, H, s->diag, &op, &proj, st))) return status;
 
     for (size_t k = 0; k < len; ++k) s->rhs[k] = -s->g[k];
-    MinresOptions mo = {s->rtol, c->set->max_linear, c->set->deadline};
+    MinresOptions mo = {.rel_tol = s->rtol, .max_iters = c->set->max_linear, .deadline = c->set->deadline};
     MinresResult mr;
     status = solve_minres(c, &op, &proj, s->rhs, s->p, &mo, &s->mw, &mr, st);
     if (status) return status;
@@ -127,7 +127,7 @@ static int si_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *st)
         solve_end(st, SOLVE_FAILED, "non-finite %s after the linearised step", isfinite(E) ? "residual" : "energy");
     else if (mr.timed_out)
         solve_end(st, SOLVE_TIMEOUT, "time limit %s reached in MINRES after %d iterations",
-                  c->set->deadline_reason ? c->set->deadline_reason : "", mr.iters);
+                  deadline_reason(&c->set->deadline), mr.iters);
     else if (mr.capped)
         solve_end(st, SOLVE_CAPPED, "MINRES cap %d reached (relative residual %.2e, asked %.2e)", c->set->max_linear,
                   mr.res0 > 0 ? mr.res / mr.res0 : 0.0, s->rtol);

@@ -66,7 +66,7 @@ int agreement_solve_first_step(const AgreementCase *c, const char *spec, double 
         solve_settings_default(&set);
         set.eps = eps;
         EnergyTrace tr = {0, 1};
-        st = solver_solve(solver, &s.sim.pb, &set, out->dv, &out->st, trace_hook, &tr);
+        st = solver_solve(solver, &s.sim.pb, &set, out->dv, &out->st, NULL, trace_hook, &tr);
         out->monotone = tr.monotone;
     }
     if (st) fprintf(stderr, "%s: %s\n", spec, mpm_last_error());

@@ -41,7 +41,6 @@
  * The outer methods and presets run again on a problem built with the
  * MLS-MPM gradient substitute and fused P2G (SPEC 9). */
 #include <math.h>
-#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -339,7 +338,7 @@ static int run_solve(Solver *s, Problem *P, const SolveSettings *set, SolveStats
     if (!dv) return MPM_EINTERNAL;
     memcpy(dv, P->dv0, sizeof(double) * 3 * (size_t)P->n);
     memset(tr, 0, sizeof *tr);
-    int rc = solver_solve(s, &P->f.pb, set, dv, st, trace_hook, tr);
+    int rc = solver_solve(s, &P->f.pb, set, dv, st, NULL, trace_hook, tr);
     free(dv);
     return rc;
 }
@@ -371,8 +370,7 @@ static void check_solver(Solver *s, const char *who, unsigned outer_flags, Probl
     int needed = st.outer_iters;
 
     /* a deadline in the past: every method stops before its first iteration */
-    set.deadline = omp_get_wtime() - 1.0;
-    set.deadline_reason = "a test deadline";
+    set.deadline = deadline_in(-1.0, "a test deadline");
     rc = run_solve(s, P, &set, &st, &tr);
     CHECK(rc == MPM_OK && st.status == SOLVE_TIMEOUT && st.outer_iters == 0 && strstr(st.reason, "a test deadline"),
           "%s: past deadline: status %s after %d iterations (%s)", who, solve_status_name(st.status), st.outer_iters,

@@ -45,7 +45,7 @@ static SolveStatus solve_with(const char *outer, StepProblem *pb, const double *
     memcpy(dv, dv0, sizeof(double) * len);
     SolveStats ss;
     memset(&ss, 0, sizeof ss);
-    st = solver_solve(s, pb, &set, dv, &ss, NULL, NULL);
+    st = solver_solve(s, pb, &set, dv, &ss, NULL, NULL, NULL);
     CHECK(st == MPM_OK, "%s: solver_solve: %s", name, mpm_last_error());
     printf("%s: %s, %d outer, %ld linear iterations, residual %.3e\n", name, solve_status_name(ss.status),
            ss.outer_iters, ss.linear_iters, ss.residual);

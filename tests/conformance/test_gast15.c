@@ -344,7 +344,7 @@ static void gast15_scene(const char *scene, double scale, double tau)
     solve_settings_default(&set);
     SolveStats ss;
     Trace0 tr = {NAN};
-    st = solver_solve(gs, pb, &set, dv, &ss, first_energy, &tr);
+    st = solver_solve(gs, pb, &set, dv, &ss, NULL, first_energy, &tr);
     CHECK(st == MPM_OK && ss.status == SOLVE_CONVERGED, "%s gast15: status %s (%s)", scene,
           solve_status_name(ss.status), ss.reason);
     CHECK(tr.E0 == E_guess, "%s: starts at E %.17g, the smaller initial guess has %.17g", scene, tr.E0, E_guess);
@@ -365,7 +365,7 @@ static void gast15_scene(const char *scene, double scale, double tau)
     rs.eps = 1e-12;
     problem_initial_guess(pb, dvr);
     SolveStats sr;
-    st = solver_solve(ref, pb, &rs, dvr, &sr, NULL, NULL);
+    st = solver_solve(ref, pb, &rs, dvr, &sr, NULL, NULL, NULL);
     CHECK(st == MPM_OK && sr.status == SOLVE_CONVERGED, "%s pn-cholmod: %s", scene, solve_status_name(sr.status));
 
     /* energy norm of the true Hessian at dv* (one CHOLMOD factorisation) */
@@ -439,7 +439,7 @@ static void first_cg(const char *spec, int projected, PcgStop mode, int rel_from
     set.max_outer = 1;
     SolveStats ss;
     problem_initial_guess(pb, dv);
-    if (!st) st = solver_solve(s, pb, &set, dv, &ss, NULL, NULL);
+    if (!st) st = solver_solve(s, pb, &set, dv, &ss, NULL, NULL, NULL);
     CHECK(st == MPM_OK && ss.outer_iters == 1, "%s: one iteration: %s", spec, mpm_last_error());
     /* the same linear solve by hand, at the starting point */
     problem_initial_guess(pb, dv);
@@ -533,7 +533,7 @@ static void tangents(void)
         SolveStats ss;
         g_probe_projected = -1;
         problem_initial_guess(&f.pb, dv);
-        if (!st) st = solver_solve(s, &f.pb, &set, dv, &ss, NULL, NULL);
+        if (!st) st = solver_solve(s, &f.pb, &set, dv, &ss, NULL, NULL, NULL);
         CHECK(st == MPM_OK && g_probe_projected == want[k], "%s: inverse approximation set up on a %s tangent", spec[k],
               g_probe_projected == 1 ? "projected" : g_probe_projected == 0 ? "unprojected" : "missing");
         solver_destroy(s);
@@ -600,7 +600,7 @@ static void semi_implicit(void)
         solve_settings_default(&set);
         SolveStats ss;
         vec_copy(len, dv0, dv);
-        if (!st) st = solver_solve(si, pb, &set, dv, &ss, NULL, NULL);
+        if (!st) st = solver_solve(si, pb, &set, dv, &ss, NULL, NULL, NULL);
         CHECK(st == MPM_OK && ss.status == SOLVE_CONVERGED && ss.outer_iters == 1 && ss.linear_iters > 0,
               "semi-implicit: status %s (%s), %d / %ld iterations", solve_status_name(ss.status), ss.reason,
               ss.outer_iters, ss.linear_iters);
@@ -623,7 +623,7 @@ static void semi_implicit(void)
             problem_initial_guess(pb, dvr);
             if (!st) st = solver_from_spec("pn-cholmod", NULL, 0, &ref);
             SolveStats sr;
-            if (!st) st = solver_solve(ref, pb, &rs, dvr, &sr, NULL, NULL);
+            if (!st) st = solver_solve(ref, pb, &rs, dvr, &sr, NULL, NULL, NULL);
             for (size_t k = 0; k < len; ++k) g[k] = dv[k] - dvr[k], D[k] = dvr[k] - lin[k];
             double rs_rel = vec_norm(len, g) / vec_norm(len, D);
             CHECK(st == MPM_OK && rs_rel < 1e-3, "small deformation: one step vs the solution %.3e", rs_rel);

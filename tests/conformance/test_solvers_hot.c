@@ -29,7 +29,7 @@ static int first_step(const char *spec, SolveStats *out)
         problem_initial_guess(&sim.pb, dv);
         SolveSettings set;
         solve_settings_default(&set);
-        st = solver_solve(s, &sim.pb, &set, dv, out, NULL, NULL);
+        st = solver_solve(s, &sim.pb, &set, dv, out, NULL, NULL, NULL);
     }
     free(dv);
     solver_destroy(s);

@@ -38,7 +38,7 @@ int main(void)
     SolveSettings set;
     solve_settings_default(&set);
     SolveStats st;
-    CHECK(solver_solve(s, pb, &set, dv, &st, NULL, NULL) == 0, "solve");
+    CHECK(solver_solve(s, pb, &set, dv, &st, NULL, NULL, NULL) == 0, "solve");
     CHECK(st.status == SOLVE_CONVERGED, "converged (status %d)", st.status);
     double worst_sticky = 0, worst_slip_n = 0, worst_slip_t = 0, worst_free = 0;
     for (int i = 0; i < n; ++i) {

@@ -136,7 +136,7 @@ static void slide(const char *friction, int frames, SlideResult *out)
         dv = realloc(dv, sizeof(double) * 3 * (size_t)sim.pb.n_nodes);
         problem_initial_guess(&sim.pb, dv);
         SolveStats ss;
-        if ((st = solver_solve(solver, &sim.pb, &set_, dv, &ss, NULL, NULL))) break;
+        if ((st = solver_solve(solver, &sim.pb, &set_, dv, &ss, NULL, NULL, NULL))) break;
         CHECK(ss.status == SOLVE_CONVERGED, "step %d not converged", out->steps);
         if ((st = step_end(&sim, dv))) break;
         out->steps++;

@@ -136,7 +136,7 @@ int main(void)
     MinresResult res;
 
     /* 1. unpreconditioned */
-    MinresOptions o = {1e-12, 1000, 0.0};
+    MinresOptions o = {.rel_tol = 1e-12, .max_iters = 1000};
     int st = minres_solve(&op, NULL, NULL, b, x, &o, &w, &res);
     CHECK(st == MPM_OK && !res.capped, "minres: %s", mpm_last_error());
     CHECK(rel_err(x, xs) < 1e-9, "indefinite system: relative error %.3e against the dense solve", rel_err(x, xs));
@@ -150,7 +150,7 @@ int main(void)
     /* 2. the residual never grows, and equals the true one at every cap */
     double last = INFINITY;
     for (int k = 1; k <= N; ++k) {
-        MinresOptions ok = {1e-14, k, 0.0};
+        MinresOptions ok = {.rel_tol = 1e-14, .max_iters = k};
         st = minres_solve(&op, NULL, NULL, b, x, &ok, &w, &res);
         dense_apply(&A, x, r);
         for (int i = 0; i < N; ++i) r[i] = b[i] - r[i];
@@ -187,7 +187,7 @@ int main(void)
           "projected: relative error %.3e, x0 = (%g %g %g)", rel_err(x, xs), x[0], x[1], x[2]);
 
     /* 5. cap and zero right-hand side */
-    MinresOptions o3 = {1e-12, 3, 0.0};
+    MinresOptions o3 = {.rel_tol = 1e-12, .max_iters = 3};
     st = minres_solve(&op, NULL, NULL, b, x, &o3, &w, &res);
     CHECK(st == MPM_OK && res.capped && res.iters == 3, "cap 3: capped %d after %d", res.capped, res.iters);
     double zero[N] = {0};
