@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/event_log.h"
 #include "core/error.h"
 
 #if defined(__x86_64__) && defined(__GNUC__)
@@ -22,12 +23,12 @@ double machine_best_time(void (*fn)(void *), void *ctx, double min_s, double *sp
 {
     enum { MAX_KEEP = 4096 };
     double *t = malloc(sizeof(double) * MAX_KEEP);
-    double best = 1e300, start = omp_get_wtime();
+    double best = 1e300, start = event_clock();
     int reps = 0;
-    while (reps < 3 || omp_get_wtime() - start < min_s) {
-        double t0 = omp_get_wtime();
+    while (reps < 3 || event_clock() - start < min_s) {
+        double t0 = event_clock();
         fn(ctx);
-        double dt = omp_get_wtime() - t0;
+        double dt = event_clock() - t0;
         if (dt < best) best = dt;
         if (t && reps < MAX_KEEP) t[reps] = dt;
         if (++reps > 100000) break;

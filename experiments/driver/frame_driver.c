@@ -1,11 +1,11 @@
 /* The frame driver (frame_driver.h). */
 #include "experiments/driver/frame_driver.h"
 
-#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/event_log.h"
 #include "core/error.h"
 #include "experiments/driver/progress.h"
 
@@ -34,7 +34,7 @@ static void set_deadline(const FrameDriver *d, double run_t0, SolveSettings *set
         set->deadline = deadline_in(d->max_step_s, why);
         snprintf(why, len, "--max-step-seconds %g", d->max_step_s);
     }
-    /* run_t0 is on OpenMP's wall clock, the one of deadlines (event_clock) */
+    /* run_t0 is on the clock of deadlines (event_clock) */
     if (d->max_run_s > 0 && (!set->deadline.active || run_t0 + d->max_run_s < set->deadline.at)) {
         set->deadline = (Deadline){.active = 1, .at = run_t0 + d->max_run_s, .reason = why};
         snprintf(why, len, "--max-run-seconds %g", d->max_run_s);
@@ -52,7 +52,7 @@ int frame_driver_run(const FrameDriver *d, Simulation *sim, Solver *solver, Solv
     Iteration hook = {d, &prog, 0, 0, 0.0};
     char deadline_why[64];
     stop_reason[0] = '\0';
-    double run_t0 = omp_get_wtime();
+    double run_t0 = event_clock();
     memset(sum, 0, sizeof *sum);
     while (sim->frame < d->frames && !sum->stopped) {
         FrameSums f;
@@ -85,7 +85,7 @@ int frame_driver_run(const FrameDriver *d, Simulation *sim, Solver *solver, Solv
                 sum->stopped = 1;
                 break;
             }
-            if (d->max_run_s > 0 && sim->frame < d->frames && omp_get_wtime() - run_t0 >= d->max_run_s) {
+            if (d->max_run_s > 0 && sim->frame < d->frames && event_clock() - run_t0 >= d->max_run_s) {
                 /* the run's budget is spent with frames left: this step was the last */
                 snprintf(stop_reason, reason_len, "time limit --max-run-seconds %g reached at frame %d step %d",
                          d->max_run_s, f.frame, f.steps - 1);
@@ -117,7 +117,7 @@ int frame_driver_run(const FrameDriver *d, Simulation *sim, Solver *solver, Solv
             sum->worst_status = worse(sum->worst_status, next.status);
         }
     }
-    sum->wall_s = omp_get_wtime() - run_t0;
+    sum->wall_s = event_clock() - run_t0;
 done:
     progress_clear(&prog);
     time_step_work_free(&work);

@@ -1,23 +1,24 @@
 #include "experiments/driver/progress.h"
 
-#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <unistd.h>
+
+#include "core/event_log.h"
 
 void progress_init(Progress *p, int total_frames)
 {
     const char *ci = getenv("CI");
     p->enabled = isatty(STDERR_FILENO) && !(ci && *ci);
     p->total_frames = total_frames;
-    p->t_start = omp_get_wtime();
+    p->t_start = event_clock();
     p->last_print = 0.0;
 }
 
 void progress_update(Progress *p, double fraction_done, int frame, int step, int iter, double residual, double step_s)
 {
     if (!p->enabled) return;
-    double now = omp_get_wtime();
+    double now = event_clock();
     if (now - p->last_print < 0.2) return; /* at most 5 redraws a second */
     p->last_print = now;
     double elapsed = now - p->t_start;

@@ -1,6 +1,6 @@
 /* One time step of a simulation with a solver: step_begin (P2G, the step
  * problem), the initial guess, the solve, step_end (G2P, ...), timed by
- * phase. Everything that advances a simulation goes through time_step_run:
+ * phase through the event log (core/event_log.h). Everything that advances a simulation goes through time_step_run:
  * the frame driver, and tests that drive single steps. */
 #ifndef MPM_TIME_STEP_H
 #define MPM_TIME_STEP_H
@@ -13,6 +13,10 @@
 typedef struct StepWork {
     double *dv;
     int cap;
+    /* where the step's phases are timed (core/step_phases.h: P2G, the solve's
+     * phases, G2P, and the whole step): a caller's log that records a whole
+     * run; NULL: the solver's own (Solver.log) */
+    EventLog *log;
     /* optional (NULL = none): called after the solve and before step_end with
      * the step problem and the solver's dv, when the step is applied (the
      * reference solve of --error-ref). Its time is in no timing column
