@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/block_traversal.h"
 #include "core/error.h"
 #include "core/kernel.h"
 #include "core/radix_sort.h"
@@ -207,30 +208,25 @@ int grid_build(Grid *g, Stencils *st, Particles *p, double dx)
             pb_blocks[8 * q + o] = block_insert(g, pack_block(B[0] + (o >> 2), B[1] + ((o >> 1) & 1), B[2] + (o & 1)));
     }
     /* Occupancy bits, parallel over particle blocks of one colour. */
-    for (int c = 0; c < MPM_NUM_COLORS; ++c) {
-#pragma omp parallel for schedule(dynamic, 4)
-        for (int qi = st->pcolor.color_start[c]; qi < st->pcolor.color_start[c + 1]; ++qi) {
-            int q = st->pcolor.color_blocks[qi];
-            const int *b0 = st->base + 3 * (size_t)st->pcolor.block_start[q];
-            int B[3] = {floor_div_pow2(b0[0], 2) * 4, floor_div_pow2(b0[1], 2) * 4, floor_div_pow2(b0[2], 2) * 4};
-            /* Particles come sorted by cell: OR the cell's slots with a
-             * weight first, then set their bits once per cell. */
-            int k = st->pcolor.block_start[q], k_end = st->pcolor.block_start[q + 1];
-            while (k < k_end) {
-                const int *base = st->base + 3 * (size_t)k;
-                uint32_t slots = 0;
-                for (; k < k_end && same_cell(st->base + 3 * (size_t)k, base); ++k) {
-                    double w[MPM_STENCIL];
-                    stencil_weights(st, (size_t)k, w, NULL);
-                    for (int s = 0; s < MPM_STENCIL; ++s) slots |= (uint32_t)(w[s] > 0.0) << s;
-                }
-                for (int s = 0; s < MPM_STENCIL; ++s) {
-                    if (!((slots >> s) & 1u)) continue;
-                    int r[3] = {base[0] + s / 9 - B[0], base[1] + (s / 3) % 3 - B[1], base[2] + s % 3 - B[2]};
-                    int o = ((r[0] >> 2) << 2) | ((r[1] >> 2) << 1) | (r[2] >> 2);
-                    int l = ((r[0] & 3) << 4) | ((r[1] & 3) << 2) | (r[2] & 3);
-                    g->block_mask[pb_blocks[8 * q + o]] |= 1ull << l;
-                }
+    MPM_FOR_EACH_COLORED_BLOCK(&st->pcolor, q, k0, k_end) {
+        const int *b0 = st->base + 3 * (size_t)k0;
+        int B[3] = {floor_div_pow2(b0[0], 2) * 4, floor_div_pow2(b0[1], 2) * 4, floor_div_pow2(b0[2], 2) * 4};
+        /* Particles come sorted by cell: OR the cell's slots with a
+         * weight first, then set their bits once per cell. */
+        MPM_FOR_EACH_CELL(st->base, k0, k_end, k, k1) {
+            const int *base = st->base + 3 * (size_t)k;
+            uint32_t slots = 0;
+            for (int kk = k; kk < k1; ++kk) {
+                double w[MPM_STENCIL];
+                stencil_weights(st, (size_t)kk, w, NULL);
+                for (int s = 0; s < MPM_STENCIL; ++s) slots |= (uint32_t)(w[s] > 0.0) << s;
+            }
+            for (int s = 0; s < MPM_STENCIL; ++s) {
+                if (!((slots >> s) & 1u)) continue;
+                int r[3] = {base[0] + s / 9 - B[0], base[1] + (s / 3) % 3 - B[1], base[2] + s % 3 - B[2]};
+                int o = ((r[0] >> 2) << 2) | ((r[1] >> 2) << 1) | (r[2] >> 2);
+                int l = ((r[0] & 3) << 4) | ((r[1] & 3) << 2) | (r[2] & 3);
+                g->block_mask[pb_blocks[8 * q + o]] |= 1ull << l;
             }
         }
     }

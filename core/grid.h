@@ -9,9 +9,9 @@
  *
  * Particles are kept sorted by the block of their base node; `pcolor` groups
  * those particle blocks into 8 parity colours, so scatters (P2G, gradient,
- * Hessian assembly, matrix-free products) run in parallel without atomics:
- * a particle touches nodes base..base+2, and two same-colour particle blocks
- * are >= 8 nodes apart. */
+ * Hessian assembly, matrix-free products) run in parallel without atomics
+ * (core/block_traversal.h): a particle touches nodes base..base+2, and two
+ * same-colour particle blocks are >= 8 nodes apart. */
 #ifndef MPM_GRID_H
 #define MPM_GRID_H
 

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/block_traversal.h"
 #include "core/error.h"
 #include "core/fcr.h"
 #include "core/fcr4.h"
@@ -109,20 +110,13 @@ int problem_prepare(StepProblem *pb, const Grid *g, const Stencils *st, const Pa
      * (SPEC 4, HOT §5.2). Scatter by particle-block colour. */
     double *num = pb->kappa;
     memset(num, 0, sizeof(double) * (size_t)g->n);
-    const NodeColoring *pc = &st->pcolor;
-    for (int c = 0; c < MPM_NUM_COLORS; ++c) {
-#pragma omp parallel for schedule(dynamic, 4)
-        for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
-            int q = pc->color_blocks[qi];
-            for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
-                const int *node = st->node + 27 * (size_t)k;
-                double w[27];
-                stencil_weights(st, (size_t)k, w, NULL);
-                double s = p->mass[k] * pb->stiff[k];
-                for (int t = 0; t < 27; ++t)
-                    if (node[t] >= 0) num[node[t]] += w[t] * s;
-            }
-        }
+    MPM_FOR_EACH_COLORED_PARTICLE(&st->pcolor, k) {
+        const int *node = st->node + 27 * (size_t)k;
+        double w[27];
+        stencil_weights(st, (size_t)k, w, NULL);
+        double s = p->mass[k] * pb->stiff[k];
+        for (int t = 0; t < 27; ++t)
+            if (node[t] >= 0) num[node[t]] += w[t] * s;
     }
     double min_pos = INFINITY;
     for (int i = 0; i < g->n; ++i) {
@@ -295,36 +289,26 @@ void problem_gradient(StepProblem *pb, const double *dv, double *grad)
 #pragma omp parallel for schedule(static)
     for (int i = 0; i < pb->n_nodes; ++i)
         for (int d = 0; d < 3; ++d) grad[3 * i + d] = m[i] * (dv[3 * i + d] - dt * pb->gravity[d]);
-    const NodeColoring *pc = &st->pcolor;
-    for (int c = 0; c < MPM_NUM_COLORS; ++c) {
-#pragma omp parallel for schedule(dynamic, 4)
-        for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
-            int q = pc->color_blocks[qi];
-            int k = pc->block_start[q], kend = pc->block_start[q + 1];
-            while (k < kend) {
-                /* the particles of one cell (same base node) share their stencil */
-                const int *b0 = st->base + 3 * (size_t)k;
-                int k1 = k + 1;
-                while (k1 < kend && memcmp(st->base + 3 * (size_t)k1, b0, 3 * sizeof(int)) == 0) ++k1;
-                /* the next cell's node ids, read only at its scatter (a
-                 * cell's particles between: no hardware stream covers them) */
-                __builtin_prefetch(st->node + 27 * (size_t)k1);
-                __builtin_prefetch(st->node + 27 * (size_t)k1 + 16);
-                _Alignas(32) double f[GRADIENT_CELL_SIZE];
-                gradient_cell(k1 - k, pb->P + 9 * (size_t)k, p->F + 9 * (size_t)k, st->f1d + 18 * (size_t)k,
-                              p->vol + k, dt, f, pb->gradient_kernel);
-                /* node ids: the first particle's; where its weight is 0, another's */
-                const int *node = st->node + 27 * (size_t)k;
-                for (int t = 0; t < 27; ++t) {
-                    int i = node[t];
-                    for (int kk = k + 1; i < 0 && kk < k1; ++kk) i = st->node[27 * (size_t)kk + t];
-                    if (i < 0) continue;
-                    const double *ft = f + 12 * (t / 3) + t % 3;
-                    grad[3 * i] += ft[0];
-                    grad[3 * i + 1] += ft[4];
-                    grad[3 * i + 2] += ft[8];
-                }
-                k = k1;
+    MPM_FOR_EACH_COLORED_BLOCK(&st->pcolor, q, k0, kend) {
+        /* the particles of one cell (same base node) share their stencil */
+        MPM_FOR_EACH_CELL(st->base, k0, kend, k, k1) {
+            /* the next cell's node ids, read only at its scatter (a
+             * cell's particles between: no hardware stream covers them) */
+            __builtin_prefetch(st->node + 27 * (size_t)k1);
+            __builtin_prefetch(st->node + 27 * (size_t)k1 + 16);
+            _Alignas(32) double f[GRADIENT_CELL_SIZE];
+            gradient_cell(k1 - k, pb->P + 9 * (size_t)k, p->F + 9 * (size_t)k, st->f1d + 18 * (size_t)k,
+                          p->vol + k, dt, f, pb->gradient_kernel);
+            /* node ids: the first particle's; where its weight is 0, another's */
+            const int *node = st->node + 27 * (size_t)k;
+            for (int t = 0; t < 27; ++t) {
+                int i = node[t];
+                for (int kk = k + 1; i < 0 && kk < k1; ++kk) i = st->node[27 * (size_t)kk + t];
+                if (i < 0) continue;
+                const double *ft = f + 12 * (t / 3) + t % 3;
+                grad[3 * i] += ft[0];
+                grad[3 * i + 1] += ft[4];
+                grad[3 * i + 2] += ft[8];
             }
         }
     }
@@ -417,43 +401,34 @@ static int build_pattern(StepProblem *pb, Bsr *H)
     memset(pb->rowmask, 0, sizeof(uint64_t) * 2 * (size_t)n);
     uint64_t full[27][2];
     full_stencil_masks(full);
-    const NodeColoring *pc = &st->pcolor;
-    for (int c = 0; c < MPM_NUM_COLORS; ++c) {
-#pragma omp parallel for schedule(dynamic, 4)
-        for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
-            int q = pc->color_blocks[qi];
-            /* one pass per cell, not per particle: the particles of a cell
-             * (same base node, consecutive, the runs problem_assemble sums)
-             * share their 27 nodes, and the pattern holds every pair of the
-             * cell's node union, the blocks scatter_cell adds to (a node is
-             * missing from a particle's stencil only where its weight is
-             * exactly 0) */
-            int k = pc->block_start[q], kend = pc->block_start[q + 1];
-            while (k < kend) {
-                const int *b0 = st->base + 3 * (size_t)k;
-                int node[27];
-                memcpy(node, st->node + 27 * (size_t)k, sizeof node);
-                int k1 = k + 1;
-                for (; k1 < kend && memcmp(st->base + 3 * (size_t)k1, b0, 3 * sizeof(int)) == 0; ++k1)
-                    for (int t = 0; t < 27; ++t)
-                        if (node[t] < 0) node[t] = st->node[27 * (size_t)k1 + t];
-                k = k1;
-                int all = 1;
-                for (int t = 0; t < 27; ++t) all &= node[t] >= 0;
-                for (int s = 0; s < 27; ++s) {
-                    int i = node[s];
-                    if (i < 0) continue;
-                    uint64_t *rm = pb->rowmask + 2 * (size_t)i;
-                    if (all) {
-                        rm[0] |= full[s][0];
-                        rm[1] |= full[s][1];
-                        continue;
-                    }
-                    for (int t = 0; t < 27; ++t) {
-                        if (node[t] < 0) continue;
-                        int o = g_pair_offset[s][t];
-                        rm[o >> 6] |= 1ull << (o & 63);
-                    }
+    MPM_FOR_EACH_COLORED_BLOCK(&st->pcolor, q, k0, kend) {
+        /* one pass per cell, not per particle: the particles of a cell
+         * (same base node, consecutive, the runs problem_assemble sums)
+         * share their 27 nodes, and the pattern holds every pair of the
+         * cell's node union, the blocks scatter_cell adds to (a node is
+         * missing from a particle's stencil only where its weight is
+         * exactly 0) */
+        MPM_FOR_EACH_CELL(st->base, k0, kend, k, k1) {
+            int node[27];
+            memcpy(node, st->node + 27 * (size_t)k, sizeof node);
+            for (int kk = k + 1; kk < k1; ++kk)
+                for (int t = 0; t < 27; ++t)
+                    if (node[t] < 0) node[t] = st->node[27 * (size_t)kk + t];
+            int all = 1;
+            for (int t = 0; t < 27; ++t) all &= node[t] >= 0;
+            for (int s = 0; s < 27; ++s) {
+                int i = node[s];
+                if (i < 0) continue;
+                uint64_t *rm = pb->rowmask + 2 * (size_t)i;
+                if (all) {
+                    rm[0] |= full[s][0];
+                    rm[1] |= full[s][1];
+                    continue;
+                }
+                for (int t = 0; t < 27; ++t) {
+                    if (node[t] < 0) continue;
+                    int o = g_pair_offset[s][t];
+                    rm[o >> 6] |= 1ull << (o & 63);
                 }
             }
         }
@@ -636,7 +611,6 @@ static int assemble_cells(StepProblem *pb, Bsr *H, int fused, int projected)
     const Stencils *st = pb->st;
     const Particles *p = pb->parts;
     const double dt2 = pb->dt * pb->dt;
-    const NodeColoring *pc = &st->pcolor;
     int oom = 0;
 #pragma omp parallel
     {
@@ -646,43 +620,34 @@ static int assemble_cells(StepProblem *pb, Bsr *H, int fused, int projected)
         double *Ablock = NULL;
         size_t cap = 0;
         int failed = 0;
-        for (int c = 0; c < MPM_NUM_COLORS; ++c) {
-#pragma omp for schedule(dynamic, 2)
-            for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
-                int q = pc->color_blocks[qi];
-                int k0 = pc->block_start[q], kend = pc->block_start[q + 1];
-                const double *A0 = pb->A ? pb->A + 81 * (size_t)k0 : NULL;
-                if (fused) {
-                    size_t need = (size_t)(kend - k0);
-                    if (need > cap) {
-                        double *grown = realloc(Ablock, sizeof(double) * 81 * need);
-                        if (!grown) {
-                            failed = 1;
-                            continue;
-                        }
-                        Ablock = grown;
-                        cap = need;
+        /* chunks of 2, not 4: a block's tangents and cell kernels outweigh other scatters' blocks */
+        MPM_FOR_EACH_COLORED_BLOCK_IN_TEAM(&st->pcolor, 2, q, k0, kend) {
+            const double *A0 = pb->A ? pb->A + 81 * (size_t)k0 : NULL;
+            if (fused) {
+                size_t need = (size_t)(kend - k0);
+                if (need > cap) {
+                    double *grown = realloc(Ablock, sizeof(double) * 81 * need);
+                    if (!grown) {
+                        failed = 1;
+                        continue;
                     }
-                    tangent_range(pb, projected, (size_t)k0, (size_t)kend, Ablock);
-                    A0 = Ablock;
+                    Ablock = grown;
+                    cap = need;
                 }
-                int k = k0;
-                while (k < kend) {
-                    const int *b0 = st->base + 3 * (size_t)k;
-                    int k1 = k + 1;
-                    while (k1 < kend && memcmp(st->base + 3 * (size_t)k1, b0, 3 * sizeof(int)) == 0) ++k1;
-                    hessian_cell(k1 - k, A0 + 81 * (size_t)(k - k0), pb->a + 81 * (size_t)k, p->vol + k, dt2, Kloc,
-                                 pb->cell_kernel);
-                    /* node ids of the cell: union over its particles (a node
-                     * is -1 only where every weight vanishes) */
-                    int node[27];
-                    memcpy(node, st->node + 27 * (size_t)k, sizeof node);
-                    for (int kk = k + 1; kk < k1; ++kk)
-                        for (int t = 0; t < 27; ++t)
-                            if (node[t] < 0) node[t] = st->node[27 * (size_t)kk + t];
-                    scatter_cell(pb, H, node, Kloc);
-                    k = k1;
-                }
+                tangent_range(pb, projected, (size_t)k0, (size_t)kend, Ablock);
+                A0 = Ablock;
+            }
+            MPM_FOR_EACH_CELL(st->base, k0, kend, k, k1) {
+                hessian_cell(k1 - k, A0 + 81 * (size_t)(k - k0), pb->a + 81 * (size_t)k, p->vol + k, dt2, Kloc,
+                             pb->cell_kernel);
+                /* node ids of the cell: union over its particles (a node
+                 * is -1 only where every weight vanishes) */
+                int node[27];
+                memcpy(node, st->node + 27 * (size_t)k, sizeof node);
+                for (int kk = k + 1; kk < k1; ++kk)
+                    for (int t = 0; t < 27; ++t)
+                        if (node[t] < 0) node[t] = st->node[27 * (size_t)kk + t];
+                scatter_cell(pb, H, node, Kloc);
             }
         }
         free(Ablock);
@@ -748,41 +713,34 @@ void problem_hessvec(StepProblem *pb, const double *x, double *y)
 #pragma omp parallel for schedule(static)
     for (int i = 0; i < n; ++i)
         for (int d = 0; d < 3; ++d) y[3 * i + d] = m[i] * xp[3 * i + d];
-    const NodeColoring *pc = &st->pcolor;
-    for (int c = 0; c < MPM_NUM_COLORS; ++c) {
-#pragma omp parallel for schedule(dynamic, 4)
-        for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
-            int q = pc->color_blocks[qi];
-            for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
-                const int *node = st->node + 27 * (size_t)k;
-                const double *a = pb->a + 81 * (size_t)k, *A = pb->A + 81 * (size_t)k;
-                /* dF = sum_j x_j a_j^T (SPEC 3 "G2P of x") */
-                double G[9] = {0};
-                for (int t = 0; t < 27; ++t) {
-                    int j = node[t];
-                    if (j < 0) continue;
-                    const double *xj = xp + 3 * (size_t)j, *at = a + 3 * t;
-                    for (int r = 0; r < 3; ++r)
-                        for (int cc = 0; cc < 3; ++cc) G[3 * r + cc] += xj[r] * at[cc];
-                }
-                double dP[9];
-                for (int e = 0; e < 9; ++e) {
-                    const double *row = A + 9 * e;
-                    double s = 0.0;
-                    for (int f = 0; f < 9; ++f) s += row[f] * G[f];
-                    dP[e] = s;
-                }
-                double s = dt2 * p->vol[k];
-                for (int t = 0; t < 27; ++t) {
-                    int i = node[t];
-                    if (i < 0) continue;
-                    double f[3];
-                    m3_mulv(dP, a + 3 * t, f);
-                    y[3 * i] += s * f[0];
-                    y[3 * i + 1] += s * f[1];
-                    y[3 * i + 2] += s * f[2];
-                }
-            }
+    MPM_FOR_EACH_COLORED_PARTICLE(&st->pcolor, k) {
+        const int *node = st->node + 27 * (size_t)k;
+        const double *a = pb->a + 81 * (size_t)k, *A = pb->A + 81 * (size_t)k;
+        /* dF = sum_j x_j a_j^T (SPEC 3 "G2P of x") */
+        double G[9] = {0};
+        for (int t = 0; t < 27; ++t) {
+            int j = node[t];
+            if (j < 0) continue;
+            const double *xj = xp + 3 * (size_t)j, *at = a + 3 * t;
+            for (int r = 0; r < 3; ++r)
+                for (int cc = 0; cc < 3; ++cc) G[3 * r + cc] += xj[r] * at[cc];
+        }
+        double dP[9];
+        for (int e = 0; e < 9; ++e) {
+            const double *row = A + 9 * e;
+            double s = 0.0;
+            for (int f = 0; f < 9; ++f) s += row[f] * G[f];
+            dP[e] = s;
+        }
+        double s = dt2 * p->vol[k];
+        for (int t = 0; t < 27; ++t) {
+            int i = node[t];
+            if (i < 0) continue;
+            double f[3];
+            m3_mulv(dP, a + 3 * t, f);
+            y[3 * i] += s * f[0];
+            y[3 * i + 1] += s * f[1];
+            y[3 * i + 2] += s * f[2];
         }
     }
     if (pb->n_dirichlet) {
@@ -822,25 +780,18 @@ void problem_diagonal(StepProblem *pb, double *D)
         memset(Di, 0, 9 * sizeof(double));
         Di[0] = Di[4] = Di[8] = m[i];
     }
-    const NodeColoring *pc = &st->pcolor;
-    for (int c = 0; c < MPM_NUM_COLORS; ++c) {
-#pragma omp parallel for schedule(dynamic, 4)
-        for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
-            int q = pc->color_blocks[qi];
+    MPM_FOR_EACH_COLORED_PARTICLE(&st->pcolor, k) {
+        const int *node = st->node + 27 * (size_t)k;
+        const double *a = pb->a + 81 * (size_t)k, *A = pb->A + 81 * (size_t)k;
+        double s = dt2 * p->vol[k];
+        for (int t = 0; t < 27; ++t) {
+            int i = node[t];
+            if (i < 0) continue;
             double B[27], K[9];
-            for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
-                const int *node = st->node + 27 * (size_t)k;
-                const double *a = pb->a + 81 * (size_t)k, *A = pb->A + 81 * (size_t)k;
-                double s = dt2 * p->vol[k];
-                for (int t = 0; t < 27; ++t) {
-                    int i = node[t];
-                    if (i < 0) continue;
-                    contract_left(A, a + 3 * t, B);
-                    contract_right(B, a + 3 * t, s, K);
-                    double *Di = D + 9 * (size_t)i;
-                    for (int e = 0; e < 9; ++e) Di[e] += K[e];
-                }
-            }
+            contract_left(A, a + 3 * t, B);
+            contract_right(B, a + 3 * t, s, K);
+            double *Di = D + 9 * (size_t)i;
+            for (int e = 0; e < 9; ++e) Di[e] += K[e];
         }
     }
     if (pb->n_dirichlet) {

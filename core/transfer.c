@@ -2,6 +2,7 @@
 
 #include <string.h>
 
+#include "core/block_traversal.h"
 #include "core/mat3.h"
 
 void transfer_p2g(Grid *g, const Stencils *st, const Particles *p)
@@ -11,32 +12,25 @@ void transfer_p2g(Grid *g, const Stencils *st, const Particles *p)
     if (n == 0) return; /* no particles: no nodes (and possibly no arrays yet) */
     memset(g->mass, 0, sizeof(double) * (size_t)n);
     memset(g->v, 0, sizeof(double) * 3 * (size_t)n);
-    const NodeColoring *pc = &st->pcolor;
-    for (int c = 0; c < MPM_NUM_COLORS; ++c) {
-#pragma omp parallel for schedule(dynamic, 4)
-        for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
-            int q = pc->color_blocks[qi];
-            for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
-                const double *xp = p->x + 3 * (size_t)k, *vp = p->v + 3 * (size_t)k, *Cp = p->C + 9 * (size_t)k;
-                const int *base = st->base + 3 * (size_t)k;
-                const int *node = st->node + MPM_STENCIL * (size_t)k;
-                double w[MPM_STENCIL];
-                stencil_weights(st, (size_t)k, w, NULL);
-                double mp = p->mass[k];
-                for (int s = 0; s < MPM_STENCIL; ++s) {
-                    int i = node[s];
-                    if (i < 0) continue;
-                    double r[3] = {(base[0] + s / 9) * dx - xp[0], (base[1] + (s / 3) % 3) * dx - xp[1],
-                                   (base[2] + s % 3) * dx - xp[2]};
-                    double u[3];
-                    m3_mulv(Cp, r, u);
-                    double wm = w[s] * mp;
-                    g->mass[i] += wm;
-                    g->v[3 * i] += wm * (vp[0] + u[0]);
-                    g->v[3 * i + 1] += wm * (vp[1] + u[1]);
-                    g->v[3 * i + 2] += wm * (vp[2] + u[2]);
-                }
-            }
+    MPM_FOR_EACH_COLORED_PARTICLE(&st->pcolor, k) {
+        const double *xp = p->x + 3 * (size_t)k, *vp = p->v + 3 * (size_t)k, *Cp = p->C + 9 * (size_t)k;
+        const int *base = st->base + 3 * (size_t)k;
+        const int *node = st->node + MPM_STENCIL * (size_t)k;
+        double w[MPM_STENCIL];
+        stencil_weights(st, (size_t)k, w, NULL);
+        double mp = p->mass[k];
+        for (int s = 0; s < MPM_STENCIL; ++s) {
+            int i = node[s];
+            if (i < 0) continue;
+            double r[3] = {(base[0] + s / 9) * dx - xp[0], (base[1] + (s / 3) % 3) * dx - xp[1],
+                           (base[2] + s % 3) * dx - xp[2]};
+            double u[3];
+            m3_mulv(Cp, r, u);
+            double wm = w[s] * mp;
+            g->mass[i] += wm;
+            g->v[3 * i] += wm * (vp[0] + u[0]);
+            g->v[3 * i + 1] += wm * (vp[1] + u[1]);
+            g->v[3 * i + 2] += wm * (vp[2] + u[2]);
         }
     }
 #pragma omp parallel for schedule(static)
@@ -84,37 +78,30 @@ void transfer_p2g_apic_force(Grid *g, const Stencils *st, const Particles *p, co
     if (n == 0) return;
     memset(g->mass, 0, sizeof(double) * (size_t)n);
     memset(g->v, 0, sizeof(double) * 3 * (size_t)n);
-    const NodeColoring *pc = &st->pcolor;
-    for (int c = 0; c < MPM_NUM_COLORS; ++c) {
-#pragma omp parallel for schedule(dynamic, 4)
-        for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
-            int q = pc->color_blocks[qi];
-            for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
-                const double *xp = p->x + 3 * (size_t)k, *vp = p->v + 3 * (size_t)k, *Cp = p->C + 9 * (size_t)k;
-                const int *base = st->base + 3 * (size_t)k;
-                const int *node = st->node + MPM_STENCIL * (size_t)k;
-                double w[MPM_STENCIL], dw[3 * MPM_STENCIL];
-                stencil_weights(st, (size_t)k, w, dw);
-                double mp = p->mass[k], K[9] = {0};
-                if (force) {
-                    transfer_explicit_stress(force, p, (size_t)k, K);
-                    for (int e = 0; e < 9; ++e) K[e] *= -force->dt;
-                }
-                for (int s = 0; s < MPM_STENCIL; ++s) {
-                    int i = node[s];
-                    if (i < 0) continue;
-                    double r[3] = {(base[0] + s / 9) * dx - xp[0], (base[1] + (s / 3) % 3) * dx - xp[1],
-                                   (base[2] + s % 3) * dx - xp[2]};
-                    double u[3], f[3];
-                    m3_mulv(Cp, r, u);
-                    m3_mulv(K, dw + 3 * s, f);
-                    double wm = w[s] * mp;
-                    g->mass[i] += wm;
-                    g->v[3 * i] += wm * (vp[0] + u[0]) + f[0];
-                    g->v[3 * i + 1] += wm * (vp[1] + u[1]) + f[1];
-                    g->v[3 * i + 2] += wm * (vp[2] + u[2]) + f[2];
-                }
-            }
+    MPM_FOR_EACH_COLORED_PARTICLE(&st->pcolor, k) {
+        const double *xp = p->x + 3 * (size_t)k, *vp = p->v + 3 * (size_t)k, *Cp = p->C + 9 * (size_t)k;
+        const int *base = st->base + 3 * (size_t)k;
+        const int *node = st->node + MPM_STENCIL * (size_t)k;
+        double w[MPM_STENCIL], dw[3 * MPM_STENCIL];
+        stencil_weights(st, (size_t)k, w, dw);
+        double mp = p->mass[k], K[9] = {0};
+        if (force) {
+            transfer_explicit_stress(force, p, (size_t)k, K);
+            for (int e = 0; e < 9; ++e) K[e] *= -force->dt;
+        }
+        for (int s = 0; s < MPM_STENCIL; ++s) {
+            int i = node[s];
+            if (i < 0) continue;
+            double r[3] = {(base[0] + s / 9) * dx - xp[0], (base[1] + (s / 3) % 3) * dx - xp[1],
+                           (base[2] + s % 3) * dx - xp[2]};
+            double u[3], f[3];
+            m3_mulv(Cp, r, u);
+            m3_mulv(K, dw + 3 * s, f);
+            double wm = w[s] * mp;
+            g->mass[i] += wm;
+            g->v[3 * i] += wm * (vp[0] + u[0]) + f[0];
+            g->v[3 * i + 1] += wm * (vp[1] + u[1]) + f[1];
+            g->v[3 * i + 2] += wm * (vp[2] + u[2]) + f[2];
         }
     }
     transfer_normalise_grid_velocity(g, force);
@@ -127,37 +114,30 @@ void transfer_p2g_mls(Grid *g, const Stencils *st, const Particles *p, const Exp
     if (n == 0) return;
     memset(g->mass, 0, sizeof(double) * (size_t)n);
     memset(g->v, 0, sizeof(double) * 3 * (size_t)n);
-    const NodeColoring *pc = &st->pcolor;
-    for (int c = 0; c < MPM_NUM_COLORS; ++c) {
-#pragma omp parallel for schedule(dynamic, 4)
-        for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
-            int q = pc->color_blocks[qi];
-            for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
-                const double *xp = p->x + 3 * (size_t)k, *vp = p->v + 3 * (size_t)k, *Cp = p->C + 9 * (size_t)k;
-                const int *base = st->base + 3 * (size_t)k;
-                const int *node = st->node + MPM_STENCIL * (size_t)k;
-                double w[MPM_STENCIL];
-                stencil_weights(st, (size_t)k, w, NULL);
-                double mp = p->mass[k], Q[9], mv[3] = {mp * vp[0], mp * vp[1], mp * vp[2]};
-                for (int e = 0; e < 9; ++e) Q[e] = mp * Cp[e];
-                if (force) { /* Q_p = m_p C_p - dt V_p D_p^-1 P F^T (supplement 3.1) */
-                    double K[9];
-                    transfer_explicit_stress(force, p, (size_t)k, K);
-                    for (int e = 0; e < 9; ++e) Q[e] -= force->dt * dinv * K[e];
-                }
-                for (int s = 0; s < MPM_STENCIL; ++s) {
-                    int i = node[s];
-                    if (i < 0) continue;
-                    double r[3] = {(base[0] + s / 9) * dx - xp[0], (base[1] + (s / 3) % 3) * dx - xp[1],
-                                   (base[2] + s % 3) * dx - xp[2]};
-                    double u[3];
-                    m3_mulv(Q, r, u);
-                    g->mass[i] += w[s] * mp;
-                    g->v[3 * i] += w[s] * (mv[0] + u[0]);
-                    g->v[3 * i + 1] += w[s] * (mv[1] + u[1]);
-                    g->v[3 * i + 2] += w[s] * (mv[2] + u[2]);
-                }
-            }
+    MPM_FOR_EACH_COLORED_PARTICLE(&st->pcolor, k) {
+        const double *xp = p->x + 3 * (size_t)k, *vp = p->v + 3 * (size_t)k, *Cp = p->C + 9 * (size_t)k;
+        const int *base = st->base + 3 * (size_t)k;
+        const int *node = st->node + MPM_STENCIL * (size_t)k;
+        double w[MPM_STENCIL];
+        stencil_weights(st, (size_t)k, w, NULL);
+        double mp = p->mass[k], Q[9], mv[3] = {mp * vp[0], mp * vp[1], mp * vp[2]};
+        for (int e = 0; e < 9; ++e) Q[e] = mp * Cp[e];
+        if (force) { /* Q_p = m_p C_p - dt V_p D_p^-1 P F^T (supplement 3.1) */
+            double K[9];
+            transfer_explicit_stress(force, p, (size_t)k, K);
+            for (int e = 0; e < 9; ++e) Q[e] -= force->dt * dinv * K[e];
+        }
+        for (int s = 0; s < MPM_STENCIL; ++s) {
+            int i = node[s];
+            if (i < 0) continue;
+            double r[3] = {(base[0] + s / 9) * dx - xp[0], (base[1] + (s / 3) % 3) * dx - xp[1],
+                           (base[2] + s % 3) * dx - xp[2]};
+            double u[3];
+            m3_mulv(Q, r, u);
+            g->mass[i] += w[s] * mp;
+            g->v[3 * i] += w[s] * (mv[0] + u[0]);
+            g->v[3 * i + 1] += w[s] * (mv[1] + u[1]);
+            g->v[3 * i + 2] += w[s] * (mv[2] + u[2]);
         }
     }
     transfer_normalise_grid_velocity(g, force);

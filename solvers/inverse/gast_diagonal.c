@@ -23,6 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/block_traversal.h"
 #include "core/error.h"
 #include "core/problem.h"
 #include "solvers/inverse_approx.h"
@@ -69,26 +70,19 @@ static int gd_setup(InvApprox *self, const InvSetupInput *in)
     const Stencils *st = pb->st;
     const Particles *p = pb->parts;
     const double dt2 = pb->dt * pb->dt;
-    const NodeColoring *pc = &st->pcolor;
-    /* scatter by particle-block colour: no two particles of one colour touch
-     * the same node (core/grid.h) */
-    for (int c = 0; c < MPM_NUM_COLORS; ++c) {
-#pragma omp parallel for schedule(dynamic, 4)
-        for (int qi = pc->color_start[c]; qi < pc->color_start[c + 1]; ++qi) {
-            int q = pc->color_blocks[qi];
-            for (int k = pc->block_start[q]; k < pc->block_start[q + 1]; ++k) {
-                const int *node = st->node + 27 * (size_t)k;
-                double w[27], dw[81];
-                stencil_weights(st, (size_t)k, w, dw);
-                const double s = dt2 * p->vol[k], lm = pb->lambda[k] + pb->mu[k], mu = pb->mu[k];
-                for (int t = 0; t < 27; ++t) {
-                    int i = node[t];
-                    if (i < 0) continue;
-                    const double *gw = dw + 3 * t;
-                    double g2 = gw[0] * gw[0] + gw[1] * gw[1] + gw[2] * gw[2];
-                    for (int a = 0; a < 3; ++a) L[3 * (size_t)i + a] += s * (lm * gw[a] * gw[a] + mu * g2);
-                }
-            }
+    /* the scatter of every particle's term: race-free and in a fixed order
+     * by the coloured traversal (core/block_traversal.h) */
+    MPM_FOR_EACH_COLORED_PARTICLE(&st->pcolor, k) {
+        const int *node = st->node + 27 * (size_t)k;
+        double w[27], dw[81];
+        stencil_weights(st, (size_t)k, w, dw);
+        const double s = dt2 * p->vol[k], lm = pb->lambda[k] + pb->mu[k], mu = pb->mu[k];
+        for (int t = 0; t < 27; ++t) {
+            int i = node[t];
+            if (i < 0) continue;
+            const double *gw = dw + 3 * t;
+            double g2 = gw[0] * gw[0] + gw[1] * gw[1] + gw[2] * gw[2];
+            for (int a = 0; a < 3; ++a) L[3 * (size_t)i + a] += s * (lm * gw[a] * gw[a] + mu * g2);
         }
     }
     int bad = n;
