@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Report of an experiment-matrix run: `mpmbench matrix report DIR` runs this
-with the python3 on PATH (or MPM_PYTHON), which needs matplotlib (Debian:
-python3-matplotlib; or pip install matplotlib in a virtual environment).
+with the first Python that can import matplotlib of MPM_PYTHON, the python3
+on PATH and /usr/bin/python3 (Debian: python3-matplotlib; or pip install
+matplotlib in a virtual environment).
 
 usage: matrix_report.py DIR
 
@@ -68,8 +69,10 @@ left out with a line saying why. Style: scripts/figure_style.py.
 Accuracy (matrix_report_accuracy.py, beside this file): work precision and
 the robustness grid of `matrix run --check`.
 
-Exit status: 0, 2 for a directory without cells.csv/matrix.json, 1 when
-matplotlib is missing.
+Exit status: 0; 2 for a directory without cells.csv/matrix.json or a Python
+without matplotlib (`mpmbench matrix report` looks for one that has it); 1
+for an internal failure (one line; MPM_TRACEBACK=1 prints the traceback).
+Every error is one line with the prefix "mpmbench: error: matrix report:".
 """
 import csv
 import json
@@ -108,7 +111,8 @@ def ranks_text(invocation):
 
 
 def die(msg, code=2):
-    print(f"matrix report: {msg}", file=sys.stderr)
+    """One line with the program's common prefix, and the exit status (2: bad input)."""
+    print(f"mpmbench: error: matrix report: {msg}", file=sys.stderr)
     sys.exit(code)
 
 
@@ -1026,8 +1030,8 @@ def main(argv):
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
-        die(f"{sys.executable} has no matplotlib (Debian: apt-get install python3-matplotlib; "
-            "in a virtual environment: pip install matplotlib)", 1)
+        die(f"{sys.executable} cannot import matplotlib (Debian: apt-get install python3-matplotlib; in a virtual "
+            "environment: pip install matplotlib; or set MPM_PYTHON to a python3 that has it)")
     style.apply(matplotlib)
     baseline = meta.get("baseline") or ""
     repeat = int(number((meta.get("matrix") or {}).get("repeat"), 1))
@@ -1211,4 +1215,12 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    try:
+        sys.exit(main(sys.argv))
+    except Exception as e:  # a bug or an unreadable file: one line, status 1 (internal failure)
+        if os.environ.get("MPM_TRACEBACK"):
+            raise
+        import traceback
+        where = traceback.extract_tb(e.__traceback__)[-1]
+        die(f"internal failure: {type(e).__name__}: {e} (at {os.path.basename(where.filename)}:{where.lineno} in "
+            f"{where.name}; MPM_TRACEBACK=1 prints the traceback)".replace("\n", " "), 1)
