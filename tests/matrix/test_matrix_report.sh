@@ -73,11 +73,11 @@ check "worst status of frames" test "$(field "toy stiffness=1e+05" fast worst_st
 check "a timed-out cell: no speedup" test "$(field "toy stiffness=1e+07" fast speedup_total)" = ""
 check "a timed-out cell: worst status timeout" test "$(field "toy stiffness=1e+07" fast worst_status)" = timeout
 check "second scene: speedup 2" test "$(field "toy2 stiffness=1e+05" fast speedup_total)" = "2.000000"
-check "markdown table row" grep -q "| fast | ok | 3 | 1.33 | 3.00 | 4.00 | 60 | 30 | 5.00 | capped |" "$d/report.md"
+check "markdown table row, the capped cell marked" grep -q "| fast | ok not converged | 3 | 1.33 | 3.00 not converged | 4.00 | 60 | 30 | 5.00 | capped |" "$d/report.md"
 check "per-scene window noted" grep -q "^(first_timed_frame=1)" "$d/report.md"
-check "overview: s/frame per solver" grep -q "^| toy stiffness=1e+05 | 4.00 | 1.33 |$" "$d/report.md"
+check "overview: s/frame per solver" grep -q "^| toy stiffness=1e+05 | 4.00 | 1.33 not converged |$" "$d/report.md"
 check "overview: a cell that did not end ok" grep -q "^| toy stiffness=1e+07 | 2.00 | - |$" "$d/report.md"
-check "overview: speedups total / max per frame" grep -q "^| toy stiffness=1e+05 | 3.00 / 4.00 |$" "$d/report.md"
+check "overview: speedups total / max per frame" grep -q "^| toy stiffness=1e+05 | 3.00 not converged / 4.00 |$" "$d/report.md"
 python3 - "$d/profile.csv" >"$tmp/profile.txt" <<'PY'
 import csv, sys
 got = {(r["case"], r["solver"]): r["ratio"] for r in csv.DictReader(open(sys.argv[1]))}
