@@ -180,9 +180,9 @@ def markdown(header, rows):
 def slug(text):
     """A file-name part from a case title: a scene file's folders and its ".json" left out
     (stiffness_00_sphere-on-box.png, not ..._sphere-on-box.json.png)."""
-    text = re.sub(r"(?:[^\s/]*/)+", "", text)  # folders of a scene path
+    text = re.sub(r"(?:[^\s/]*/)+(?=[^\s/]*\.json\b)", "", text)  # the folders of a scene file
     text = re.sub(r"\.json\b", "", text)
-    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_.")[:60]
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text)[:60]
 
 
 def value_key(text):
