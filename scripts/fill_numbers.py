@@ -315,7 +315,7 @@ def baselines_lead(threads, what="geo"):
         if "hot" in t and alg:
             ratios.append(min(alg) / t["hot"])
     if not ratios:
-        raise Missing(f"results/baselines: no scene with hot and an algebraic multigrid at {threads} threads")
+        raise Missing(f"results/baselines: no scene with hot and an algebraic multigrid at {threads} thread{'s' if threads != 1 else ''}")
     if what == "range":
         return span(ratios, 3)
     if what == "n":
