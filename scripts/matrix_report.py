@@ -708,7 +708,6 @@ def profile_figure(plt, ratios, order):
         ax.plot(xs, ys, **kw)
     ax.set_xscale("log", base=2)
     ax.set_xlim(1.0, tau_max)
-    from matplotlib.ticker import ScalarFormatter
     from matplotlib.ticker import FuncFormatter
     ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
     ax.set_ylim(0.0, 1.03)
@@ -1174,7 +1173,7 @@ def answer_lines(summary, facts, order, baseline, cells, cases, repeat, dropped,
     is fastest in a case only by more than the noise (NOISE_FLOOR, or the runs' ranges with
     repeats) over the next; closer cases are ties, and said so."""
     lines = list(lead)
-    n_cmp, n_clear = facts["compared"], facts["clear"]
+    n_cmp = facts["compared"]
     noise = noise_words(repeat)
     ranked = sorted(order, key=lambda s: (-summary[s]["fastest"], -summary[s]["tied"], -geomean(summary[s]["ratios"])))
     if n_cmp and len(order) > 1:
@@ -1236,8 +1235,8 @@ def answer_lines(summary, facts, order, baseline, cells, cases, repeat, dropped,
         caveats.append(f"{plural(busy, 'cell run')} on a busy machine (marked busy"
                        + ("; left out of the ranking and the speedups above)" if n_cmp else ")"))
     if facts["not_compared"] and n_cmp:
-        caveats.append(f"cases not compared: " + ", ".join(f"{plural(n, 'cell')} {why}"
-                                                          for why, n in facts["not_compared"].items()))
+        caveats.append("cases not compared: " + ", ".join(f"{plural(n, 'cell')} {why}"
+                                                         for why, n in facts["not_compared"].items()))
     if dropped:
         caveats.append(f"the performance profile compares {compared} of {plural(compared + len(dropped), 'case')} "
                        f"(left out: a solver stopped at another accuracy, did no work, failed or ran on a busy "
