@@ -143,6 +143,7 @@ def cells_ok(study):
 
 
 def fastest(study, solver):
+    """Cases where the solver is faster than every other by more than the noise (summary.json)."""
     s = solver_summary(study, solver)
     return of(s["fastest_in"], s["fastest_of"])
 
@@ -314,7 +315,7 @@ def baselines_lead(threads, what="geo"):
         if "hot" in t and alg:
             ratios.append(min(alg) / t["hot"])
     if not ratios:
-        raise Missing(f"results/baselines: no scene with hot and an algebraic multigrid at {threads} threads")
+        raise Missing(f"results/baselines: no scene with hot and an algebraic multigrid at {threads} thread{'s' if threads != 1 else ''}")
     if what == "range":
         return span(ratios, 3)
     if what == "n":
@@ -414,6 +415,7 @@ NUMBERS = {
     "scenes.particles_max": scenes_particles_max,
     "scenes.hot_fastest": scenes_hot_fastest,
     "scenes.hot_fastest_summary": lambda: fastest("scenes-bench", "hot"),
+    "scenes.hot_tied": lambda: str(solver_summary("scenes-bench", "hot")["tied_fastest_in"]),
     "scenes.hot_geomean": lambda: geomean("scenes-bench", "hot"),
     "scenes.hot_range": lambda: speedup_range("scenes-bench", "hot"),
     "history.cells": lambda: cells_ok("scenes-history"),

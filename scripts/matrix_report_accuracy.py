@@ -11,9 +11,11 @@ whose frames.csv has pos_rms (run against a reference run):
   * a work-precision case is a case without its eps: one line per solver
     through its cells in eps order (cells that did not end ok are left out);
   * figures/wp_NN_CASE.png: wall time against median err_h (each point
-    labelled by its eps, the targets as labelled lines) and, when the matrix
-    has reference runs, against the last frame's pos_rms (without them the
-    panel is left out and the report says why), log-log, one line per solver;
+    labelled by its eps, the targets inside the data's range as labelled
+    lines) and against the last frame's pos_rms, log-log, one line per
+    solver, a cell run on a busy machine ringed and one with a step not
+    converged crossed; a panel without data (no error_ref: no err_h; no
+    reference run: no pos_rms) is left out and the report says why;
   * "time to reach err_h <= 1e-2 / 1e-3 / 1e-4 / 1e-6": along the solver's eps sequence
     (loosest first), the first cell whose median err_h is at or below the
     target, the time interpolated linearly in log(err_h)-log(time) between
@@ -173,6 +175,10 @@ def work_precision(plt, root, cells, cols, order, md_fig, md, helpers):
               "dx) against the reference run, and the timed wall time, which excludes the reference solves "
               "(their time is ref_s). Cells that did not end ok are left out.\n")
     wp_rows, problems = [], {}
+    has_err = any(math.isfinite(c.err_h) for c in acc)
+    if not has_err:
+        md.append("(No err_h panel in the figures: no cell ran with error_ref, so the per-step error was not "
+                  "measured.)\n")
     if not has_trajectory:
         md.append("(No trajectory panel in the figures: the matrix has no reference run, so pos_rms was not "
                   "measured.)\n")
@@ -205,41 +211,55 @@ def work_precision(plt, root, cells, cols, order, md_fig, md, helpers):
             rows.append(line)
         md.append("\nWall seconds (timed window) to reach a median err_h, interpolated in log-log along eps:\n")
         md.append(markdown(["solver"] + [f"err_h <= {t:g}" for t in TARGETS], rows))
-        panels = 2 if has_trajectory else 1
-        n_lab = len(lines)
+        # a panel per measure the cells have: median err_h (error_ref), pos_rms (a reference run)
+        err = {s: [(c.err_h, c.timed_wall, c) for c in pts if math.isfinite(c.err_h) and c.err_h > 0]
+               for s, pts in lines.items()}
+        pos = {s: [(c.pos_rms, c.timed_wall, c) for c in pts if math.isfinite(c.pos_rms) and c.pos_rms > 0]
+               for s, pts in lines.items()}
+        shown = [(d, lab) for d, lab in ((err, "median err_h per step"), (pos, "pos_rms at the last frame [dx]"))
+                 if any(d.values())]
+        if not shown:
+            md.append("\n(No work-precision figure: no cell has a positive err_h or pos_rms.)\n")
+            continue
+        if has_err and has_trajectory and len(shown) < 2:
+            md.append("\n(No err_h panel: no cell of this case has a positive median err_h.)\n" if shown[0][0] is pos
+                      else "\n(No pos_rms panel: no cell of this case has a positive pos_rms.)\n")
+        panels = len(shown)
+        names = list(lines)
+        drawn = {m for d, _ in shown for e in d.values() for _, _, c in e for m in c.marks()}
+        leg = names + [helpers["mark_label"][m] for m in drawn]
         width = (style.TWO_COLUMNS if panels == 2 else style.ONE_COLUMN)[0]
         fig, axes = new_figure(plt, panels, height=(style.TWO_COLUMNS[1] if panels == 2 else 2.9)
-                               + helpers["legend_height"](n_lab, width))
+                               + helpers["legend_height"](len(leg), width, leg))
         axes = list(axes) if panels == 2 else [axes]
-        a1 = axes[0]
-        names = list(lines)
         labels = []
-        for s, pts in lines.items():
-            kw = style.line_kwargs(s, names, ms=3.5)
-            e = [(c.err_h, c.timed_wall, c) for c in pts if math.isfinite(c.err_h) and c.err_h > 0]
-            if e:
-                a1.plot([x for x, _, _ in e], [y for _, y, _ in e], **kw)
-                labels.append((kw["color"], e))
-            if panels == 2:
-                p = [(c.pos_rms, c.timed_wall) for c in pts if math.isfinite(c.pos_rms) and c.pos_rms > 0]
-                if p:
-                    axes[1].plot([x for x, _ in p], [y for _, y in p], **kw)
-        labs = ["median err_h per step", "pos_rms at the last frame [dx]"]
-        for a, lab in zip(axes, labs):
+        for a, (d, lab) in zip(axes, shown):
+            marks = []
+            for s in names:
+                kw = style.line_kwargs(s, names, ms=3.5)
+                if d[s]:
+                    a.plot([x for x, _, _ in d[s]], [y for _, y, _ in d[s]], **kw)
+                    marks += [(x, y, c.marks()) for x, y, c in d[s]]
+                    if d is err:
+                        labels.append((kw["color"], d[s]))
+            helpers["mark_points"](a, marks)
             a.set_xscale("log")
             a.set_yscale("log")
             a.set_xlabel(lab)
             a.set_ylabel("wall seconds (timed window)")
-        if a1.lines:
-            for target in TARGETS:
-                a1.axvline(target, ls="--", color="0.6", lw=0.7)
-                a1.annotate(f"{target:.0e}".replace("e-0", "e-"), xy=(target, 1.0), xycoords=("data", "axes fraction"),
-                            ha="center", va="bottom", fontsize=style.FONT_PT - 2, color="0.4")
-            _label_eps(fig, a1, labels, style.FONT_PT - 2.5)
-        for a in axes:
-            if not a.lines:
-                a.text(0.5, 0.5, "no positive errors", ha="center", va="center", transform=a.transAxes)
-        helpers["legend_outside"](fig, a1)
+            helpers["plain_log_axis"](a, "x")
+            helpers["plain_log_axis"](a, "y")
+            if d is err:
+                lo, hi = sorted(a.get_xlim())
+                for target in TARGETS:
+                    if not lo * 1.2 <= target <= hi / 1.2:  # inside, clear of the axes' ends
+                        continue
+                    a.axvline(target, ls="--", color="0.6", lw=0.7)
+                    a.annotate(f"{target:.0e}".replace("e-0", "e-"), xy=(target, 1.0),
+                               xycoords=("data", "axes fraction"), ha="center", va="bottom",
+                               fontsize=style.FONT_PT - 2, color="0.4")
+                _label_eps(fig, a, labels, style.FONT_PT - 2.5)
+        helpers["legend_outside"](fig, axes[0], extra=helpers["mark_legend"](drawn))
         fig.suptitle(f"Work precision: {title}", fontsize=style.FONT_PT + 1)
         path = save(fig, root, f"wp_{i:02d}_{slug(title)}.png")
         plt.close(fig)
@@ -354,7 +374,7 @@ def robustness(plt, root, md_fig, md, order, helpers):
     ax.set_xlim(0, len(solvers))
     ax.set_ylim(len(cases), 0)
     ax.set_xticks([j + 0.5 for j in range(len(solvers))])
-    ax.set_xticklabels(solvers, rotation=35, ha="left", fontsize=style.FONT_PT - 1.5)
+    ax.set_xticklabels(solvers, rotation=90, ha="center", va="bottom", fontsize=style.FONT_PT - 1.5)
     ax.xaxis.tick_top()
     ax.set_yticks([i + 0.5 for i in range(len(cases))])
     ax.set_yticklabels(cases, fontsize=style.FONT_PT - 1.5)

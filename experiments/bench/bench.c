@@ -265,8 +265,8 @@ int bench_run(const char *what, const RunConfig *cfg)
     double min_s = 1.0;
     const char *tname = scene->transfer == TRANSFER_MLS ? "mls" : scene->transfer == TRANSFER_APIC ? "apic" : "pic_flip";
 
-    printf("bench on %s (transfer %s): %zu particles, %d active nodes, %lld blocks (%.1f per row), %d threads\n",
-           scene->name, tname, np, n, (long long)H.nnzb, (double)H.nnzb / n, threads);
+    printf("bench on %s (transfer %s): %zu particles, %d active nodes, %lld blocks (%.1f per row), %d thread%s\n",
+           scene->name, tname, np, n, (long long)H.nnzb, (double)H.nnzb / n, threads, threads == 1 ? "" : "s");
     size_t mat_bytes = bsr_bytes(&H);
     printf("  Hessian storage: %.1f MB, %.0f bytes per active node\n", mat_bytes / 1e6, (double)mat_bytes / n);
 

@@ -5,7 +5,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <errno.h>
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "core/error.h"
@@ -84,26 +87,76 @@ static int find_program(const char *name, char *out, size_t n)
     return 0;
 }
 
-/* Replaces this process by the report script (its exit status and messages are the command's). */
+/* 1 when `program -c "import matplotlib"` exits 0 (its output discarded). */
+static int imports_matplotlib(const char *program)
+{
+    fflush(stdout);
+    fflush(stderr);
+    pid_t pid = fork();
+    if (pid < 0) return 0;
+    if (pid == 0) {
+        int null = open("/dev/null", O_RDWR);
+        if (null >= 0) {
+            dup2(null, STDIN_FILENO);
+            dup2(null, STDOUT_FILENO);
+            dup2(null, STDERR_FILENO);
+        }
+        char *argv[] = {(char *)program, "-c", "import matplotlib", NULL};
+        execv(program, argv);
+        _exit(127);
+    }
+    int status;
+    while (waitpid(pid, &status, 0) < 0)
+        if (errno != EINTR) return 0;
+    return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+}
+
+/* Replaces this process by the report script run with the first Python that can import
+ * matplotlib of: MPM_PYTHON (a name looked up on PATH or a path), the python3 on PATH, the
+ * system's /usr/bin/python3 (the script's exit status and messages are the command's). None: one
+ * line naming what was tried, status 2. */
 static int matrix_report_cmd(void *args, const char *dir_arg, int *exit_code)
 {
     (void)args, (void)exit_code;
-    const char *python = getenv("MPM_PYTHON");
-    if (!python || !python[0]) python = "python3";
     const char *dir = getenv("MPM_SCRIPT_DIR");
-    char script[1200], program[4096];
+    char script[1200];
     snprintf(script, sizeof script, "%s/matrix_report.py", dir && dir[0] ? dir : MPM_SOURCE_DIR "/scripts");
     struct stat st;
     if (stat(script, &st) != 0) return mpm_error(MPM_EINPUT, "matrix report: %s not found (set MPM_SCRIPT_DIR)", script);
-    if (!find_program(python, program, sizeof program))
-        return mpm_error(MPM_EINPUT,
-                         "matrix report: no %s%s (install python3 and matplotlib: scripts/setup.sh; or set MPM_PYTHON)",
-                         python, strchr(python, '/') ? "" : " on PATH");
-    char *argv[4] = {program, script, (char *)dir_arg, NULL};
-    fflush(stdout);
-    fflush(stderr);
-    execv(program, argv);
-    return mpm_error(MPM_EINTERNAL, "matrix report: cannot run %s", program);
+    const char *env = getenv("MPM_PYTHON");
+    const char *candidates[] = {env && env[0] ? env : NULL, "python3", "/usr/bin/python3"};
+    char program[4096], tried[3][4096 + 64], found[3][4096];
+    int n_tried = 0;
+    for (int i = 0; i < 3; i++) {
+        if (!candidates[i]) continue;
+        int exists = find_program(candidates[i], program, sizeof program);
+        int seen = 0;
+        for (int k = 0; k < n_tried; k++) seen |= exists && strcmp(found[k], program) == 0;
+        if (seen) continue;
+        snprintf(found[n_tried], sizeof found[n_tried], "%s", exists ? program : "");
+        const char *what = i == 0 ? "MPM_PYTHON=" : "";
+        if (!exists)
+            snprintf(tried[n_tried++], sizeof tried[0], "%s%s (%s)", what, candidates[i],
+                     strchr(candidates[i], '/') ? "not found" : "not on PATH");
+        else if (!imports_matplotlib(program))
+            snprintf(tried[n_tried++], sizeof tried[0], "%s%s (no matplotlib)", what,
+                     strcmp(candidates[i], program) ? program : candidates[i]);
+        else {
+            if (i > 0 && env && env[0]) fprintf(stderr, "mpmbench: note: %s; using %s\n", tried[0], program);
+            char *argv[4] = {program, script, (char *)dir_arg, NULL};
+            fflush(stdout);
+            fflush(stderr);
+            execv(program, argv);
+            return mpm_error(MPM_EINTERNAL, "matrix report: cannot run %s", program);
+        }
+    }
+    char list[3 * (4096 + 64) + 16] = "";
+    for (int k = 0; k < n_tried; k++)
+        snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", k ? ", " : "", tried[k]);
+    return mpm_error(MPM_EINPUT,
+                     "matrix report: no Python that can import matplotlib (tried %s); install it (Debian: apt-get "
+                     "install python3-matplotlib; or pip install matplotlib) or set MPM_PYTHON to a python3 that has it",
+                     list);
 }
 
 const Command matrix_report_command = {
@@ -111,6 +164,8 @@ const Command matrix_report_command = {
     .operand = "DIR",
     .operand_missing = "a result directory",
     .summary = "Writes DIR/report.md with its tables and figures from a matrix run's results.",
-    .notes = "Runs scripts/matrix_report.py with the python3 found on PATH (a virtual environment with matplotlib\n"
-             "works), or with MPM_PYTHON (a program name or path); MPM_SCRIPT_DIR replaces the scripts folder.\n",
+    .notes = "Runs scripts/matrix_report.py with the first Python that can import matplotlib of MPM_PYTHON (a\n"
+             "program name or path), the python3 on PATH (a virtual environment with matplotlib works) and\n"
+             "/usr/bin/python3; MPM_SCRIPT_DIR replaces the scripts folder. Exit status 0; 2 for a folder without\n"
+             "cells.csv or matrix.json, or when no Python with matplotlib is found (one line naming what was tried).\n",
     .run = matrix_report_cmd};

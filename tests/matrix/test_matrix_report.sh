@@ -48,7 +48,8 @@ done
 printf 'level,nodes,blocks,blocks_per_row_avg,blocks_per_row_max\n0,15002,1203000,80.19,125\n1,3122,201000,64.41,125\n' >"$d/cells/c1/mg_levels.csv"
 
 "$bin" matrix report "$d" >"$tmp/report.out" 2>"$tmp/report.err"
-check "report exit 0 ($(head -c 300 "$tmp/report.err"))" test $? -eq 0
+rc=$?
+check "report exit 0 ($(head -c 300 "$tmp/report.err"))" test $rc -eq 0
 check "report files" test -s "$d/report.md" -a -s "$d/report.csv" -a -s "$d/profile.csv"
 field() { # case solver column
   python3 - "$d/report.csv" "$@" <<'PY'
@@ -72,11 +73,11 @@ check "worst status of frames" test "$(field "toy stiffness=1e+05" fast worst_st
 check "a timed-out cell: no speedup" test "$(field "toy stiffness=1e+07" fast speedup_total)" = ""
 check "a timed-out cell: worst status timeout" test "$(field "toy stiffness=1e+07" fast worst_status)" = timeout
 check "second scene: speedup 2" test "$(field "toy2 stiffness=1e+05" fast speedup_total)" = "2.000000"
-check "markdown table row" grep -q "| fast | ok | 3 | 1.33 | 3.00 | 4.00 | 60 | 30 | 5.00 | capped |" "$d/report.md"
+check "markdown table row, the capped cell marked" grep -q "| fast | ok not converged | 3 | 1.33 | 3.00 not converged | 4.00 | 60 | 30 | 5.00 | capped |" "$d/report.md"
 check "per-scene window noted" grep -q "^(first_timed_frame=1)" "$d/report.md"
-check "overview: s/frame per solver" grep -q "^| toy stiffness=1e+05 | 4.00 | 1.33 |$" "$d/report.md"
+check "overview: s/frame per solver" grep -q "^| toy stiffness=1e+05 | 4.00 | 1.33 not converged |$" "$d/report.md"
 check "overview: a cell that did not end ok" grep -q "^| toy stiffness=1e+07 | 2.00 | - |$" "$d/report.md"
-check "overview: speedups total / max per frame" grep -q "^| toy stiffness=1e+05 | 3.00 / 4.00 |$" "$d/report.md"
+check "overview: speedups total / max per frame" grep -q "^| toy stiffness=1e+05 | 3.00 not converged / 4.00 |$" "$d/report.md"
 python3 - "$d/profile.csv" >"$tmp/profile.txt" <<'PY'
 import csv, sys
 got = {(r["case"], r["solver"]): r["ratio"] for r in csv.DictReader(open(sys.argv[1]))}
@@ -118,15 +119,46 @@ PY
 check "PNGs decode, one or two columns wide ($(tail -1 "$tmp/png.txt"))" grep -q "^ok" "$tmp/png.txt"
 check "an SVG beside every PNG" bash -c "for p in '$d'/figures/*.png; do grep -q '<svg' \"\${p%.png}.svg\" || exit 1; done"
 
-# bad input: one line, exit 2; without matplotlib: one line, exit 1
+# bad input: one line with the common prefix, exit 2
 mkdir -p "$tmp/empty"
 "$bin" matrix report "$tmp/empty" >/dev/null 2>"$tmp/err"
 check "no cells.csv: exit 2, one line" test $? -eq 2 -a "$(wc -l <"$tmp/err")" -eq 1
-check "no cells.csv: message" grep -q "empty/cells.csv: not found" "$tmp/err"
-mkdir -p "$tmp/nompl/matplotlib"
+check "no cells.csv: message with the common prefix" grep -q "^mpmbench: error: matrix report: .*empty/cells.csv: not found" "$tmp/err"
+# a Python with matplotlib is found: a python3 first on PATH that cannot import it (a virtual
+# environment without it), MPM_PYTHON unset, and the report still runs (with /usr/bin/python3);
+# MPM_PYTHON without matplotlib falls back with a note; no usable Python (matplotlib hidden from
+# every interpreter): one line with the common prefix naming what was tried and MPM_PYTHON, exit 2
+mkdir -p "$tmp/fakebin" "$tmp/nompl/matplotlib"
+printf '#!/bin/sh\necho "ModuleNotFoundError: No module named matplotlib" >&2\nexit 1\n' >"$tmp/fakebin/python3"
+chmod +x "$tmp/fakebin/python3"
 echo 'raise ImportError("hidden for the test")' >"$tmp/nompl/matplotlib/__init__.py"
-PYTHONPATH="$tmp/nompl" "$bin" matrix report "$d" >/dev/null 2>"$tmp/err"
-check "no matplotlib: exit 1, one line naming the package" test $? -eq 1 -a "$(wc -l <"$tmp/err")" -eq 1
-check "no matplotlib: message" grep -q "python3-matplotlib" "$tmp/err"
+if /usr/bin/python3 -c 'import matplotlib' 2>/dev/null; then
+  env -u MPM_PYTHON PATH="$tmp/fakebin:$PATH" "$bin" matrix report "$d" >"$tmp/out" 2>"$tmp/err"
+  rc=$?
+  check "a python3 without matplotlib first on PATH, MPM_PYTHON unset: the report runs ($(head -c 300 "$tmp/err"))" \
+    test $rc -eq 0 -a ! -s "$tmp/err"
+  MPM_PYTHON="$tmp/fakebin/python3" "$bin" matrix report "$d" >"$tmp/out" 2>"$tmp/err"
+  rc=$?
+  check "MPM_PYTHON without matplotlib: falls back, with a note ($(head -c 300 "$tmp/err"))" \
+    test $rc -eq 0 -a "$(grep -c "^mpmbench: note: MPM_PYTHON=$tmp/fakebin/python3 (no matplotlib); using " "$tmp/err")" -eq 1
+else
+  echo "(skipped the fallback checks: /usr/bin/python3 has no matplotlib)"
+fi
+MPM_PYTHON="$tmp/fakebin/python3" PYTHONPATH="$tmp/nompl" PATH="$tmp/fakebin:$PATH" \
+  "$bin" matrix report "$d" >"$tmp/out" 2>"$tmp/err"
+rc=$?
+check "no usable Python: exit 2, one line (exit $rc, $(wc -l <"$tmp/err") lines)" test $rc -eq 2 -a "$(wc -l <"$tmp/err")" -eq 1
+check "no usable Python: the common prefix, what was tried, the package, MPM_PYTHON ($(cat "$tmp/err"))" grep -q \
+  "^mpmbench: error: matrix report: no Python that can import matplotlib (tried MPM_PYTHON=$tmp/fakebin/python3 (no matplotlib), /usr/bin/python3 (no matplotlib)); .*python3-matplotlib.*set MPM_PYTHON" \
+  "$tmp/err"
+MPM_PYTHON=/no/such/python PYTHONPATH="$tmp/nompl" "$bin" matrix report "$d" >"$tmp/out" 2>"$tmp/err"
+check "no usable Python: a missing MPM_PYTHON named as such ($(cat "$tmp/err"))" \
+  grep -q "(tried MPM_PYTHON=/no/such/python (not found), " "$tmp/err"
+# the script run directly by a Python without matplotlib: the same prefix and status
+PYTHONPATH="$tmp/nompl" "${MPM_PYTHON:-python3}" "$src/scripts/matrix_report.py" "$d" >/dev/null 2>"$tmp/err"
+rc=$?
+check "the script without matplotlib: exit 2, one line naming the package and MPM_PYTHON ($(cat "$tmp/err"))" \
+  test $rc -eq 2 -a "$(wc -l <"$tmp/err")" -eq 1 -a \
+  "$(grep -c '^mpmbench: error: matrix report: .*python3-matplotlib.*MPM_PYTHON' "$tmp/err")" -eq 1
 expect_input_error "matrix report: expected a result directory" matrix report
 finish

@@ -45,7 +45,8 @@ cell c2 C 1e-05 cell 2 1e-3 1
 cell c3 C 1e-07 cell 3 5e-4 1
 
 "$bin" matrix report "$d" >"$tmp/out" 2>"$tmp/err"
-check "report exit 0 ($(head -c 300 "$tmp/err"))" test $? -eq 0
+rc=$?
+check "report exit 0 ($(head -c 300 "$tmp/err"))" test $rc -eq 0
 md="$d/report.md"
 check "work-precision section" grep -q "^### Work precision" "$md"
 check "the answer: fastest to each target" grep -q "^- Accuracy, fastest to reach a median per-step error: err_h <= 0.01: A (1 of 1 cases); err_h <= 0.001: A (1 of 1 cases); err_h <= 0.0001: B (1 of 1 cases)" "$md"
@@ -96,6 +97,7 @@ echo "id,scene,solver,eps,scale,threads,frames_asked,first_timed_frame,set,solve
 echo "x,toy,A,1e-07,1,2,1,0,,,ok,0,1,1,1,1,0,1,1,1,1,1,1e-8,1.0,converged,10,1,0,1" >>"$tmp/plain/cells.csv"
 printf 'frame,steps,outer_iters,linear_iters,wall_s,max_residual,status\n0,1,1,1,1.0,1e-8,converged\n' >"$tmp/plain/cells/x/frames.csv"
 "$bin" matrix report "$tmp/plain" >/dev/null 2>"$tmp/err2"
-check "plain report: exit 0 ($(head -c 200 "$tmp/err2"))" test $? -eq 0
+rc=$?
+check "plain report: exit 0 ($(head -c 200 "$tmp/err2"))" test $rc -eq 0
 check "plain report: no work-precision section" bash -c "! grep -q 'Work precision' '$tmp/plain/report.md'"
 finish
