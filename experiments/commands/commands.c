@@ -188,7 +188,8 @@ void cli_program_usage(FILE *f)
                "  OMP_NUM_THREADS    threads when --threads is not given (1-1024)\n"
                "  OMP_WAIT_POLICY    passive on a machine shared with other jobs\n"
                "  MPM_SCENE_DIR      the folder of the built-in scenes (default: experiments/scenes)\n"
-               "  MPM_PYTHON         the Python of `matrix report` (default: python3 on PATH)\n"
+               "  MPM_PYTHON         the Python of `matrix report` (default: the first of python3 on PATH and\n"
+               "                     /usr/bin/python3 that can import matplotlib)\n"
                "  MPM_SCRIPT_DIR     the folder of matrix_report.py (default: scripts/)\n");
 }
 

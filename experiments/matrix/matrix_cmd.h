@@ -3,9 +3,10 @@
  * (experiments/matrix/matrix_run.h) and of its report
  * (scripts/matrix_report.py). Their options and help are in matrix_cmd.c.
  *
- * The report runs with the python3 found on PATH (so a virtual environment
- * with matplotlib works), or with MPM_PYTHON (a program name looked up on
- * PATH, or a path); MPM_SCRIPT_DIR replaces the folder of the script. */
+ * The report runs with the first Python that can import matplotlib of
+ * MPM_PYTHON (a program name looked up on PATH, or a path), the python3 on
+ * PATH (so a virtual environment with matplotlib works) and the system's
+ * /usr/bin/python3; MPM_SCRIPT_DIR replaces the folder of the script. */
 #ifndef MPM_MATRIX_CMD_H
 #define MPM_MATRIX_CMD_H
 

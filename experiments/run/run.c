@@ -302,8 +302,8 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     sum->particles = scene->particles.n;
     sum->threads = threads;
     if (!cfg->quiet) {
-        printf("scene %s (%zu particles, dx %.4g m), solver %s, eps %.1e, %d threads\n", scene->name, scene->particles.n,
-               scene->dx, solver->name, cfg->eps, threads);
+        printf("scene %s (%zu particles, dx %.4g m), solver %s, eps %.1e, %d thread%s\n", scene->name, scene->particles.n,
+               scene->dx, solver->name, cfg->eps, threads, threads == 1 ? "" : "s");
         if (acc.ref) printf("error reference: %s (its time is in ref_s, not in the timings)\n", error_ref_describe(acc.ref));
         printf("%6s %6s %8s %9s %9s %10s %12s  %s\n", "frame", "steps", "outer", "linear", "inner", "wall_s",
                "max_resid", "status");
