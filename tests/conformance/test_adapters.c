@@ -1,3 +1,4 @@
+/* floor: adapters */
 /* needs: MPM_WITH_CHOLMOD MPM_WITH_HYPRE */
 /* Third-party adapters (adapters/): CHOLMOD direct factorisation and one
  * hypre BoomerAMG V-cycle as inverse approximations, on synthetic SPD 3x3-

@@ -1,3 +1,4 @@
+/* floor: adapters */
 /* needs: MPM_WITH_CHOLMOD MPM_WITH_HYPRE */
 /* Setup reuse (docs/solvers.md "Setup reuse"; solvers/inverse_approx.c):
  *  1. reuse_every=1 (the default) sets up afresh at every request: the

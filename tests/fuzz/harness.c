@@ -1,3 +1,4 @@
+/* floor: core */
 #include "tests/fuzz/harness.h"
 
 #include "core/error.h"

@@ -1,3 +1,4 @@
+/* floor: scene */
 /* The paper's scene suite (HOT, Wang et al. 2020; docs/scenes.md §4, hot-scenes.md):
  * every built-in scene loads and validates at a coarse scale; particle
  * counts at --scale 1 are within 15 % of the paper's Table 2 (for Boards
