@@ -31,3 +31,9 @@ int test_summary(const char *name)
     }
     return g_test_failures ? 1 : 0;
 }
+
+int test_skip(const char *name, const char *why)
+{
+    printf("%s: SKIPPED: %s\n", name, why);
+    return TEST_SKIPPED;
+}

@@ -28,4 +28,10 @@ double test_uniform(unsigned long long *state, double lo, double hi);
 /* Prints the counts; non-zero if a check failed or if no check ran at all. */
 int test_summary(const char *name);
 
+/* The exit status of a test that cannot run here (a tool or file it needs is
+ * missing): CTest reports it as "Skipped" (tests/CMakeLists.txt). */
+#define TEST_SKIPPED 77
+/* Prints "name: SKIPPED: why" and returns TEST_SKIPPED (return it from main). */
+int test_skip(const char *name, const char *why);
+
 #endif
