@@ -49,8 +49,9 @@ PARTS = {
 # third-party headers: any <...> include matching one of these needs the part's permission
 THIRD_PARTY = ["jansson.h", "png.h", "mpi.h", "HYPRE*.h", "_hypre*.h", "cholmod*.h", "ml_*.h", "Trilinos_*.h",
                "petsc*.h", "gsl/*"]
-# generated at build time into the build folder (CMakeLists.txt)
-GENERATED = {"mpm_build_info.h", "mpm_adapters_built.h"}
+# generated at build time into the build folder (CMakeLists.txt), and the
+# part whose target carries it
+GENERATED = {"mpm_build_info.h": "run", "mpm_adapters_built.h": "adapters"}
 # the registry is the one meeting point of the adapters and the rest: it alone
 # reads their list (no file outside adapters/ includes an adapter's header)
 MEETING_POINT = ("experiments/driver/registry.c", "adapters/adapter_list.h")
@@ -197,7 +198,15 @@ def check_tests(root):
                 if not m or m.group(1) != '"':
                     continue
                 name = m.group(2)
-                if name.startswith("tests/"):
+                if "/" not in name:
+                    if name in GENERATED:
+                        target = {GENERATED[name]}
+                    elif os.path.exists(os.path.join(root, os.path.dirname(path), name)):
+                        continue
+                    else:
+                        errors.append('%s:%d: includes "%s", which is not beside it' % (path, no, name))
+                        continue
+                elif name.startswith("tests/"):
                     names = floors_of.get(name)
                     if names is None:
                         errors.append('%s:%d: includes "%s", which is not a test file' % (path, no, name))
