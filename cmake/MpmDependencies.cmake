@@ -33,15 +33,13 @@ endfunction()
 
 # Required by the core and solvers (OpenMP), the scene loader and the app
 # (jansson), the matrix runner (MPI: a study under mpirun hands cells to
-# ranks) and the renderer (libpng); GSL by the tests only.
+# ranks) and the renderer (libpng). GSL, which only the tests use, is found in
+# tests/CMakeLists.txt.
 find_package(OpenMP COMPONENTS C)
 mpm_require(OpenMP_C_FOUND "OpenMP for C" "libgomp1 (comes with gcc)")
 
 find_package(MPI COMPONENTS C)
 mpm_require(MPI_C_FOUND "MPI" "libopenmpi-dev")
-
-find_package(GSL)
-mpm_require(GSL_FOUND "GSL" "libgsl-dev")
 
 find_path(JANSSON_INCLUDE_DIR jansson.h)
 find_library(JANSSON_LIBRARY jansson)

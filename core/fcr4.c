@@ -159,6 +159,8 @@ void fcr_psi_P4(const double *F, const double *mu, const double *lambda, double 
             if (((redo >> l) & 1) || !fcr4_usual(F + 9 * l)) psi[l] = fcr_psi_P(F + 9 * l, mu[l], lambda[l], P + 9 * l);
         return;
     }
+#else
+    (void)kernel; /* off x86-64 the portable lanes are the only ones */
 #endif
     fcr4_portable(F, mu, lambda, P, psi);
 }

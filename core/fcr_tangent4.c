@@ -171,6 +171,8 @@ void fcr_dPdF4(const double *F, const double *mu, const double *lambda, int proj
                 fcr_dPdF(F + 9 * l, mu[l], lambda[l], projected, A + 81 * l);
         return;
     }
+#else
+    (void)kernel; /* off x86-64 the portable lanes are the only ones */
 #endif
     dPdF4_portable(F, mu, lambda, projected, A);
 }

@@ -74,6 +74,8 @@ void gradient_cell(int n, const double *P, const double *Fn, const double *f1d, 
         cell_avx2(n, P, Fn, f1d, vol, scale, f);
         return;
     }
+#else
+    (void)kernel; /* off x86-64 the portable kernel is the only one */
 #endif
     cell_portable(n, P, Fn, f1d, vol, scale, f);
 }

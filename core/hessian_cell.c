@@ -117,6 +117,8 @@ void hessian_cell(int n, const double *A, const double *a, const double *vol, do
         cell_avx2(n, A, a, vol, scale, K);
         return;
     }
+#else
+    (void)kernel; /* off x86-64 the portable kernel is the only one */
 #endif
     cell_portable(n, A, a, vol, scale, K);
 }

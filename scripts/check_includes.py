@@ -11,8 +11,14 @@ floor or of a sideways part is an error, so is a third-party header outside
 its floor (the compiler finds jansson.h or mpi.h from anywhere). Adapters see
 only their own header among the adapters, and only the registry reads the
 adapters' list. Modules (a .c with its .h) must not
-include each other in a circle. Prints one line per violation and exits 1 when
-there is one, 0 when there is none, 2 on bad arguments.
+include each other in a circle.
+
+Every C file under tests/ names the floor it tests in a line of its own,
+"/* floor: solvers */" (tests/CMakeLists.txt links it against that floor
+only); its project #include lines may name only that floor and the ones below
+it (TEST_FLOORS), a test helper header counting as the floor its own line
+names. Prints one line per violation and exits 1 when there is one, 0 when
+there is none, 2 on bad arguments.
 """
 import fnmatch
 import os
@@ -43,12 +49,25 @@ PARTS = {
 # third-party headers: any <...> include matching one of these needs the part's permission
 THIRD_PARTY = ["jansson.h", "png.h", "mpi.h", "HYPRE*.h", "_hypre*.h", "cholmod*.h", "ml_*.h", "Trilinos_*.h",
                "petsc*.h", "gsl/*"]
-# generated at build time into the build folder (CMakeLists.txt)
-GENERATED = {"mpm_build_info.h", "mpm_adapters_built.h"}
+# generated at build time into the build folder (CMakeLists.txt), and the
+# part whose target carries it
+GENERATED = {"mpm_build_info.h": "run", "mpm_adapters_built.h": "adapters"}
 # the registry is the one meeting point of the adapters and the rest: it alone
 # reads their list (no file outside adapters/ includes an adapter's header)
 MEETING_POINT = ("experiments/driver/registry.c", "adapters/adapter_list.h")
 SOURCE_EXT = (".c", ".h", ".inc")
+# a test's floor: the parts its #include lines may name (its floor and those below)
+TEST_FLOORS = {
+    "core": {"core"},
+    "scene": {"core", "scene"},
+    "solvers": {"core", "solvers"},
+    "adapters": {"core", "solvers", "adapters"},
+    "driver": {"core", "scene", "solvers", "adapters", "driver"},
+    "app": set(PARTS),
+}
+# outside the floors' folders: the worked example of docs/solvers.md is an inverse approximation
+EXTRA_PARTS = {"docs/examples": "solvers"}
+FLOOR_LINE = re.compile(r"^/\* floor: ([a-z ]+) \*/")
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]')
 
 
@@ -147,6 +166,65 @@ def check(root):
     return errors
 
 
+def test_floor(root, path):
+    """The floors a file under tests/ names in its floor line (a list), or None."""
+    with open(os.path.join(root, path), errors="replace") as f:
+        for line in f:
+            m = FLOOR_LINE.match(line)
+            if m:
+                return m.group(1).split()
+    return None
+
+
+def check_tests(root):
+    errors = []
+    floors_of = {}
+    files = []
+    for d, _, names in os.walk(os.path.join(root, "tests")):
+        for f in sorted(names):
+            if f.endswith((".c", ".h")):
+                path = os.path.relpath(os.path.join(d, f), root)
+                files.append(path)
+                floors_of[path] = test_floor(root, path)
+    for path in files:
+        floors = floors_of[path]
+        if not floors or any(f not in TEST_FLOORS for f in floors):
+            errors.append('%s: no "/* floor: ... */" line naming %s' % (path, " or ".join(TEST_FLOORS)))
+            continue
+        allowed = set().union(*(TEST_FLOORS[f] for f in floors))
+        with open(os.path.join(root, path), errors="replace") as f:
+            for no, line in enumerate(f, 1):
+                m = INCLUDE.match(line)
+                if not m or m.group(1) != '"':
+                    continue
+                name = m.group(2)
+                if "/" not in name:
+                    if name in GENERATED:
+                        target = {GENERATED[name]}
+                    elif os.path.exists(os.path.join(root, os.path.dirname(path), name)):
+                        continue
+                    else:
+                        errors.append('%s:%d: includes "%s", which is not beside it' % (path, no, name))
+                        continue
+                elif name.startswith("tests/"):
+                    names = floors_of.get(name)
+                    if names is None:
+                        errors.append('%s:%d: includes "%s", which is not a test file' % (path, no, name))
+                        continue
+                    target = set().union(*(TEST_FLOORS.get(f, {f}) for f in names))
+                else:
+                    extra = [p for folder, p in EXTRA_PARTS.items() if name.startswith(folder + "/")]
+                    part = extra[0] if extra else part_of(name)
+                    if part is None:
+                        errors.append('%s:%d: includes "%s", outside the floors' % (path, no, name))
+                        continue
+                    target = {part}
+                if not target <= allowed:
+                    errors.append('%s:%d: includes "%s": a test of the %s floor may use only %s' %
+                                  (path, no, name, " ".join(floors), ", ".join(sorted(allowed))))
+    return errors
+
+
 def main(argv):
     if len(argv) > 2:
         print("usage: scripts/check_includes.py [ROOT]", file=sys.stderr)
@@ -156,6 +234,8 @@ def main(argv):
         print("check_includes.py: %s: no core/ folder" % root, file=sys.stderr)
         return 2
     errors = check(root)
+    if os.path.isdir(os.path.join(root, "tests")):
+        errors += check_tests(root)
     for e in errors:
         print(e)
     return 1 if errors else 0

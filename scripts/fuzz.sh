@@ -27,7 +27,7 @@ command -v clang >/dev/null || { echo "fuzz.sh: needs clang (scripts/test.sh ins
 
 build=${MPM_FUZZ_BUILD:-build-fuzz}
 if [ ! -f "$build/CMakeCache.txt" ]; then
-  CC=clang cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMPM_FUZZ=ON >/dev/null
+  CC=clang cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMPM_FUZZ=ON -DBUILD_TESTING=OFF >/dev/null
 else
   cmake -S . -B "$build" >/dev/null # picks up a harness added since (fuzz_*.c glob)
 fi

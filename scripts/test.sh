@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # The test command (CI runs exactly `bash scripts/test.sh`, via .ci/run):
-#   0. setup (scripts/setup.sh: packages + build/) and the packages only
-#      testing needs (installed here when missing);
+#   0. the packages only testing needs (installed here when missing), then
+#      setup with the tests (scripts/setup.sh --with-tests: packages +
+#      build/ with BUILD_TESTING=ON);
 #   1. the whole CTest suite on the release build;
-#   2. the minimal build (build-minimal: no hypre, no CHOLMOD) and its unit
-#      and conformance tests;
+#   2. the minimal build (build-minimal: no hypre, CHOLMOD or ML) and its
+#      unit and conformance tests;
 #   3. the unit tests again in an ASan + UBSan build (build-asan: any
 #      address error, leak or undefined behaviour fails the test);
 #   4. each libFuzzer target for MPM_FUZZ_SECONDS (default 30) seconds;
@@ -15,14 +16,15 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 quick=${MPM_QUICK:-0}
 if [ "${1:-}" = --quick ]; then quick=1; shift; fi
-bash scripts/setup.sh
 
-# packages only testing needs: clang + its sanitizer runtime + libomp (the
+# packages only testing needs: libgsl-dev (the tests' reference eigensolvers;
+# the program does not use GSL), clang + its sanitizer runtime + libomp (the
 # fuzz build), valgrind (step 5), python3-jsonschema (tests/matrix/
 # test_matrix_schema.sh validates the matrix files against
 # docs/matrix.schema.json), python3-vtk9 (tests/cli/test_vtk.sh reads the
-# ParaView output back with VTK's reader)
-test_packages=(clang libclang-rt-14-dev libomp-dev valgrind python3-jsonschema python3-vtk9)
+# ParaView output back with VTK's reader); a test whose tool is missing is
+# reported Skipped, so CI installs them all
+test_packages=(libgsl-dev clang libclang-rt-14-dev libomp-dev valgrind python3-jsonschema python3-vtk9)
 missing=()
 for p in "${test_packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -34,6 +36,7 @@ if [ ${#missing[@]} -gt 0 ]; then
   $sudo apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
+bash scripts/setup.sh --with-tests
 
 t0=$SECONDS
 ctest --test-dir build --output-on-failure -j2 "$@"
@@ -53,7 +56,9 @@ if ! nice -n 5 cmake --build build-minimal -j"$(nproc)" -- --no-print-directory 
   echo "test.sh: minimal build failed (log: $log)" >&2
   exit 1
 fi
-# test_conformance's MLS pass needs no adapter and runs in step 1 (CI's budget);
+# test_adapters walks the built adapters (none here: Skipped) and
+# test_setup_reuse checks mg alone; test_conformance's MLS pass needs no
+# adapter and runs in step 1 (CI's budget);
 # so do the multigrid and Krylov tests: only experiments/run/registry.c and
 # provenance.c read the adapter switches, and these tests' code is the same
 # in both builds

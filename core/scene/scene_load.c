@@ -17,6 +17,7 @@
 #include "core/error.h"
 #include "core/mat3.h"
 #include "core/scene/collider_load.h"
+#include "core/scene/data_dir.h"
 #include "core/scene/json_read.h"
 #include "core/scene/noise.h"
 #include "core/scene/rng.h"
@@ -24,14 +25,11 @@
 #include "core/scene/shape.h"
 #include "core/scene/source_load.h"
 
-#ifndef MPM_SCENE_DIR
-#define MPM_SCENE_DIR "experiments/scenes"
-#endif
-
 const char *scene_dir(void)
 {
-    const char *d = getenv("MPM_SCENE_DIR");
-    return (d && d[0]) ? d : MPM_SCENE_DIR;
+    static _Thread_local char dir[1000]; /* leaves room for "/NAME.json" in a 1024-byte path */
+    data_dir_find("scenes", "MPM_SCENE_DIR", dir, sizeof dir);
+    return dir;
 }
 
 static int is_builtin_name(const char *s)

@@ -216,13 +216,14 @@ size_t scene_default_max_particles(void);
 int scene_parse_particle_budget(const char *flag, const char *text, size_t *out);
 
 /* Loads a built-in scene by name (no '/' and no ".json" suffix; looked up in
- * getenv("MPM_SCENE_DIR"), else the compile-time MPM_SCENE_DIR) or a scene
+ * scene_dir()) or a scene
  * file by path. `opt` may be NULL (scale 1, no overrides). On failure *out
  * is left empty (scene_free is still safe). */
 int scene_load(const char *name_or_path, const SceneLoadOptions *opt, Scene *out);
 void scene_free(Scene *s);
 
-/* The built-in scene directory in use. */
+/* The built-in scene directory in use: $MPM_SCENE_DIR, else share/mpmbench/scenes
+ * found relative to the executable (core/scene/data_dir.h). */
 const char *scene_dir(void);
 
 typedef void (*SceneListFn)(const char *name, const char *description, void *ctx);

@@ -187,10 +187,12 @@ void cli_program_usage(FILE *f)
                "environment:\n"
                "  OMP_NUM_THREADS    threads when --threads is not given (1-1024)\n"
                "  OMP_WAIT_POLICY    passive on a machine shared with other jobs\n"
-               "  MPM_SCENE_DIR      the folder of the built-in scenes (default: experiments/scenes)\n"
+               "  MPM_SCENE_DIR      the folder of the built-in scenes (default: share/mpmbench/scenes, found\n"
+               "                     beside the program's folder or one folder up: installed or in a build tree)\n"
                "  MPM_PYTHON         the Python of `matrix report` (default: the first of python3 on PATH and\n"
                "                     /usr/bin/python3 that can import matplotlib)\n"
-               "  MPM_SCRIPT_DIR     the folder of matrix_report.py (default: scripts/)\n");
+               "  MPM_SCRIPT_DIR     the folder of matrix_report.py (default: share/mpmbench/scripts, found\n"
+               "                     as the scenes are)\n");
 }
 
 static int help_wanted(const char *a) { return !strcmp(a, "--help") || !strcmp(a, "-h") || !strcmp(a, "help"); }

@@ -12,12 +12,9 @@
 #include <unistd.h>
 
 #include "core/error.h"
+#include "core/scene/data_dir.h"
 #include "core/threads.h"
 #include "experiments/matrix/matrix_run.h"
-
-#ifndef MPM_SOURCE_DIR
-#define MPM_SOURCE_DIR "."
-#endif
 
 #define O(field) offsetof(MatrixRunOptions, field)
 
@@ -45,10 +42,26 @@ static void matrix_run_init(void *args)
     o->jobs = 1;
 }
 
+/* FILE as given, or when it names no file and is a bare name (no '/', no
+ * ".json"), the built-in matrix of that name in share/mpmbench/matrices
+ * (found as the scenes are, core/scene/data_dir.h), so an installed program
+ * runs `matrix run smoke` from any folder. */
+static const char *matrix_file_path(const char *file, char *buf, size_t cap)
+{
+    size_t n = strlen(file);
+    struct stat st;
+    if (strchr(file, '/') || (n >= 5 && !strcmp(file + n - 5, ".json")) || stat(file, &st) == 0) return file;
+    char dir[4096];
+    if (data_dir_find("matrices", NULL, dir, sizeof dir)) return file;
+    if (snprintf(buf, cap, "%s/%s.json", dir, file) >= (int)cap || stat(buf, &st) != 0) return file;
+    return buf;
+}
+
 static int matrix_run_cmd(void *args, const char *file, int *exit_code)
 {
     int failed = 0;
-    int st = matrix_run(file, args, &failed);
+    char builtin[4200];
+    int st = matrix_run(matrix_file_path(file, builtin, sizeof builtin), args, &failed);
     if (!st && failed) *exit_code = CLI_EXIT_CHECK_FAILED;
     return st;
 }
@@ -59,7 +72,8 @@ const Command matrix_run_command = {
     .operand_missing = "a matrix file",
     .summary = "Runs every cell of an experiment matrix (experiments/matrices/*.json) in a child process and appends "
                "one row per finished cell to DIR/cells.csv; a rerun resumes.",
-    .notes = "Under mpirun -np K the cells spread over the K ranks. Exit status 0 when the matrix ran, whatever the\n"
+    .notes = "FILE may be the name of a built-in matrix (share/mpmbench/matrices/NAME.json beside the program).\n"
+             "Under mpirun -np K the cells spread over the K ranks. Exit status 0 when the matrix ran, whatever the\n"
              "cells' statuses (they are in cells.csv); 2 for a bad matrix file or option; with --check, 3 when a\n"
              "cell failed its check.\n",
     .groups = {{matrix_run_options, 0, NULL, 0, NULL}},
@@ -118,9 +132,9 @@ static int imports_matplotlib(const char *program)
 static int matrix_report_cmd(void *args, const char *dir_arg, int *exit_code)
 {
     (void)args, (void)exit_code;
-    const char *dir = getenv("MPM_SCRIPT_DIR");
-    char script[1200];
-    snprintf(script, sizeof script, "%s/matrix_report.py", dir && dir[0] ? dir : MPM_SOURCE_DIR "/scripts");
+    char dir[4096], script[4200];
+    data_dir_find("scripts", "MPM_SCRIPT_DIR", dir, sizeof dir); /* beside the binary, or $MPM_SCRIPT_DIR */
+    snprintf(script, sizeof script, "%s/matrix_report.py", dir);
     struct stat st;
     if (stat(script, &st) != 0) return mpm_error(MPM_EINPUT, "matrix report: %s not found (set MPM_SCRIPT_DIR)", script);
     const char *env = getenv("MPM_PYTHON");
@@ -164,8 +178,9 @@ const Command matrix_report_command = {
     .operand = "DIR",
     .operand_missing = "a result directory",
     .summary = "Writes DIR/report.md with its tables and figures from a matrix run's results.",
-    .notes = "Runs scripts/matrix_report.py with the first Python that can import matplotlib of MPM_PYTHON (a\n"
-             "program name or path), the python3 on PATH (a virtual environment with matplotlib works) and\n"
-             "/usr/bin/python3; MPM_SCRIPT_DIR replaces the scripts folder. Exit status 0; 2 for a folder without\n"
-             "cells.csv or matrix.json, or when no Python with matplotlib is found (one line naming what was tried).\n",
+    .notes = "Runs matrix_report.py (share/mpmbench/scripts, found from the program's folder) with the first Python\n"
+             "that can import matplotlib of MPM_PYTHON (a program name or path), the python3 on PATH (a virtual\n"
+             "environment with matplotlib works) and /usr/bin/python3; MPM_SCRIPT_DIR replaces the scripts folder.\n"
+             "Exit status 0; 2 for a folder without cells.csv or matrix.json, or when no Python with matplotlib is\n"
+             "found (one line naming what was tried).\n",
     .run = matrix_report_cmd};

@@ -6,7 +6,9 @@
  * The report runs with the first Python that can import matplotlib of
  * MPM_PYTHON (a program name looked up on PATH, or a path), the python3 on
  * PATH (so a virtual environment with matplotlib works) and the system's
- * /usr/bin/python3; MPM_SCRIPT_DIR replaces the folder of the script. */
+ * /usr/bin/python3. The script is found at run time like the scenes
+ * (core/scene/data_dir.h: share/mpmbench/scripts); MPM_SCRIPT_DIR replaces
+ * its folder. */
 #ifndef MPM_MATRIX_CMD_H
 #define MPM_MATRIX_CMD_H
 

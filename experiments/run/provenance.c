@@ -22,9 +22,6 @@
 #ifndef MPM_BUILD_TYPE
 #define MPM_BUILD_TYPE "unknown"
 #endif
-#ifndef MPM_SOURCE_DIR
-#define MPM_SOURCE_DIR "."
-#endif
 #ifndef MPM_VERSION
 #define MPM_VERSION "unknown"
 #endif
@@ -80,15 +77,19 @@ static void command_line(const char *cmd, char *out, size_t n)
     pclose(p);
 }
 
+/* The git state of the checkout the program runs in (the working
+ * directory's): a study runs from the tree whose matrix file it reads, and a
+ * commit here other than build.git_commit shows a stale binary. No path is
+ * compiled in: an installed binary has no source tree of its own. */
 static json_t *checkout_json(void)
 {
-    char cmd[1400], commit[128], dirty[16];
-    snprintf(cmd, sizeof cmd, "git -C '%s' rev-parse HEAD 2>/dev/null", MPM_SOURCE_DIR);
-    command_line(cmd, commit, sizeof commit);
-    if (!commit[0]) return json_pack("{s:s, s:s}", "path", MPM_SOURCE_DIR, "commit", "unknown (not a git checkout)");
-    snprintf(cmd, sizeof cmd, "git -C '%s' status --porcelain --untracked-files=no 2>/dev/null | wc -l", MPM_SOURCE_DIR);
-    command_line(cmd, dirty, sizeof dirty);
-    return json_pack("{s:s, s:s, s:b}", "path", MPM_SOURCE_DIR, "commit", commit, "dirty", atoi(dirty) > 0);
+    char cwd[1024], top[1024], commit[128], dirty[16];
+    if (!getcwd(cwd, sizeof cwd)) snprintf(cwd, sizeof cwd, ".");
+    command_line("git rev-parse --show-toplevel 2>/dev/null", top, sizeof top);
+    command_line("git rev-parse HEAD 2>/dev/null", commit, sizeof commit);
+    if (!top[0] || !commit[0]) return json_pack("{s:s, s:s}", "path", cwd, "commit", "unknown (not a git checkout)");
+    command_line("git status --porcelain --untracked-files=no 2>/dev/null | wc -l", dirty, sizeof dirty);
+    return json_pack("{s:s, s:s, s:b}", "path", top, "commit", commit, "dirty", atoi(dirty) > 0);
 }
 
 static const char *env_or_empty(const char *name)

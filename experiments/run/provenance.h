@@ -3,8 +3,9 @@
  *   build: version, git commit and dirty flag of the source tree when the
  *          binary was built (cmake/MpmBuildInfo.cmake), compiler, flags,
  *          build type;
- *   checkout (with_checkout only): the source tree's git commit and dirty
- *          flag now, which differ from build's when the binary is stale;
+ *   checkout (with_checkout only): the git top folder, commit and dirty
+ *          flag of the checkout the program runs in (the working
+ *          directory's), which differ from build's when the binary is stale;
  *   host, os, cpu_model, cores_online, physical_cores, omp_max_threads,
  *   threads (the run's), environment (OMP_WAIT_POLICY, OMP_NUM_THREADS,
  *   OMP_PROC_BIND, OMP_PLACES: "" when unset), libraries (hypre, CHOLMOD,

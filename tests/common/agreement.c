@@ -1,3 +1,4 @@
+/* floor: driver */
 #include "tests/common/agreement.h"
 
 #include <math.h>
@@ -9,6 +10,7 @@
 #include "core/vec.h"
 #include "experiments/driver/registry.h"
 #include "tests/common/fixture.h"
+#include "tests/common/scene_fixture.h"
 #include "tests/common/testutil.h"
 
 static const char *transfer_name(const AgreementCase *c)

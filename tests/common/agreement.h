@@ -1,3 +1,4 @@
+/* floor: driver */
 /* Solver agreement on the first step problem of a scene (SPEC 4, 5, 7, 11),
  * shared by tests/conformance/test_solvers.c (APIC, twist) and
  * test_solvers_mls.c (MLS, stretched-box and bar3); the checks and their

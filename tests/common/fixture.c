@@ -1,3 +1,4 @@
+/* floor: core */
 #include "tests/common/fixture.h"
 
 #include <math.h>
@@ -5,7 +6,6 @@
 
 #include "core/mat3.h"
 #include "core/transfer.h"
-#include "core/scene/scene_load.h"
 #include "tests/common/testutil.h"
 
 void fixture_default(FixtureOptions *o)
@@ -77,30 +77,4 @@ void fixture_free(Fixture *f)
     grid_free(&f->g);
     stencils_free(&f->st);
     particles_free(&f->p);
-}
-
-static int step_open(SceneStep *s, const char *scene, double scale, int set_transfer, TransferKind transfer)
-{
-    memset(s, 0, sizeof *s);
-    SceneLoadOptions lo = {.scale = scale};
-    int st = scene_load(scene, &lo, &s->sc);
-    if (st) return st;
-    s->loaded = 1;
-    if (set_transfer) s->sc.transfer = transfer;
-    if ((st = sim_init(&s->sim, &s->sc))) return st;
-    s->started = 1;
-    return step_begin(&s->sim);
-}
-
-int scene_step_open(SceneStep *s, const char *scene, double scale) { return step_open(s, scene, scale, 0, TRANSFER_APIC); }
-
-int scene_step_open_transfer(SceneStep *s, const char *scene, double scale, TransferKind transfer)
-{
-    return step_open(s, scene, scale, 1, transfer);
-}
-
-void scene_step_close(SceneStep *s)
-{
-    if (s->started) sim_free(&s->sim);
-    if (s->loaded) scene_free(&s->sc);
 }

@@ -1,6 +1,8 @@
+/* floor: core */
 /* A small hand-built step problem for unit tests that need no scene file:
  * a jittered lattice of particles in a cube, random velocities, APIC C and
- * deformation gradients, one or two fixed-corotated materials. */
+ * deformation gradients, one or two fixed-corotated materials. Core floor
+ * (mpm_test_core); a scene's first step problem is in scene_fixture.h. */
 #ifndef MPM_TEST_FIXTURE_H
 #define MPM_TEST_FIXTURE_H
 
@@ -33,18 +35,6 @@ typedef struct {
     int snap_to_centre;  /* 1: one coordinate of each particle, at random, at its cell's centre: the
                           * far node's weight in that axis is exactly 0 (needs dx a power of 2) */
 } FixtureOptions;
-
-/* The first step problem of a built-in scene (or scene file) at --scale,
- * ready for a solve (step_begin done). Close it whatever open returned. */
-typedef struct {
-    Scene sc;
-    Simulation sim;
-    int loaded, started;
-} SceneStep;
-int scene_step_open(SceneStep *s, const char *scene, double scale);
-/* The same with the scene's transfer replaced (as --set transfer=X). */
-int scene_step_open_transfer(SceneStep *s, const char *scene, double scale, TransferKind transfer);
-void scene_step_close(SceneStep *s);
 
 void fixture_default(FixtureOptions *o);
 int fixture_build(Fixture *f, const FixtureOptions *o);

@@ -1,3 +1,4 @@
+/* floor: solvers */
 /* Synthetic SPD 3x3-block test matrices on sparse 3D node sets, shared by
  * test_pcg, test_sgs and test_mg (header-only: tests/CMakeLists.txt builds
  * each test_*.c alone).

@@ -1,3 +1,4 @@
+/* floor: core */
 /* Minimal test helpers: CHECK records a failure with file/line and goes on;
  * a test's main returns test_summary(), non-zero if anything failed. */
 #ifndef MPM_TESTUTIL_H
@@ -27,10 +28,10 @@ double test_uniform(unsigned long long *state, double lo, double hi);
 /* Prints the counts; non-zero if a check failed or if no check ran at all. */
 int test_summary(const char *name);
 
-struct Scene;
-/* Writes `json` to a temporary file, loads it as a scene with scale `scale`
- * and the given --set overrides (key, value pairs; n_set of them), removes
- * the file. Returns scene_load's status. */
-int test_scene_from_text(const char *json, double scale, const char *const *set, int n_set, struct Scene *out);
+/* The exit status of a test that cannot run here (a tool or file it needs is
+ * missing): CTest reports it as "Skipped" (tests/CMakeLists.txt). */
+#define TEST_SKIPPED 77
+/* Prints "name: SKIPPED: why" and returns TEST_SKIPPED (return it from main). */
+int test_skip(const char *name, const char *why);
 
 #endif

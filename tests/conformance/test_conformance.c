@@ -1,3 +1,4 @@
+/* floor: driver */
 /* Conformance of every registered solver part (docs/design.md, "the one idea"; in the
  * spirit of SUNDIALS' test_sunlinsol): the loops run over the registry, so a
  * newly registered inverse approximation, outer method or preset is checked

@@ -1,3 +1,4 @@
+/* floor: driver */
 /* The worked example of docs/solvers.md ("Adding a solver"),
  * docs/examples/trace_jacobi.c, compiled here as it is: it must build
  * without warnings, honour the InvApprox contract (apply before setup

@@ -1,3 +1,4 @@
+/* floor: driver */
 /* needs: MPM_WITH_CHOLMOD */
 /* The Gast et al. 2015 parts (SPEC 8): solvers/outer/gast15.c, the strong Wolfe
  * line search, solvers/inverse/gast_diagonal.c and solvers/outer/semi_implicit.c.
@@ -48,6 +49,7 @@
 #include "solvers/outer/gast15.h"
 #include "solvers/krylov/pcg.h"
 #include "tests/common/fixture.h"
+#include "tests/common/scene_fixture.h"
 #include "tests/common/testutil.h"
 
 static void spmv_op(const void *ctx, const double *x, double *y) { bsr_spmv((const Bsr *)ctx, x, y); }

@@ -1,3 +1,4 @@
+/* floor: driver */
 /* Multigrid V-cycles as preconditioners of a real step problem with sticky
  * colliders and a stiff material: the first step of `wheel` (aluminium,
  * E = 6.9e10 Pa, clamped by the ground and touched by the pusher) at a

@@ -1,3 +1,4 @@
+/* floor: driver */
 /* needs: MPM_WITH_CHOLMOD */
 /* Solver agreement on one step problem (SPEC 4, 5, 7, 11): every registered
  * preset on the first step of `twist` at scale 5.2 (1,372 active nodes, a

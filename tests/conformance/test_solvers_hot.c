@@ -1,3 +1,4 @@
+/* floor: driver */
 /* HOT against LBFGS-H on the stretched box (HOT Fig. 18: 25 vs 106 L-BFGS
  * iterations at paper size): the multigrid initial inverse needs far fewer
  * iterations than the inexact Jacobi PCG one on the first step at scale 1.4

@@ -1,3 +1,4 @@
+/* floor: driver */
 /* needs: MPM_WITH_CHOLMOD */
 /* Solver agreement under MLS-MPM (SPEC 9; issue 21): every preset that
  * iterates to a tolerance converges on the first step of stretched-box and

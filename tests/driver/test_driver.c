@@ -1,3 +1,4 @@
+/* floor: driver */
 /* The driver floor (experiments/driver/) used as a library, the way a program
  * embedding mpmbench uses it, with no file output:
  *  - session_open makes the solver from a spec, loads the scene with its

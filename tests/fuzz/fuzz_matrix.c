@@ -1,3 +1,4 @@
+/* floor: app */
 /* libFuzzer harness: the experiment-matrix file loader (experiments/
  * matrix_file.h, issue 12). Each input is a whole matrix file; it must load
  * or fail with one recorded message, never crash, leak or hang. The scenes

@@ -1,3 +1,4 @@
+/* floor: scene */
 /* libFuzzer harness: the OBJ mesh loader (core/scene/mesh.h) and queries on what
  * it accepts (inside test, signed distance, volume: they walk the
  * bounding-volume hierarchy the loader builds). */

@@ -1,3 +1,4 @@
+/* floor: scene */
 /* libFuzzer harness: the scene loader (core/scene/scene_load.h), called directly on a
  * scene file. Every input must give MPM_OK or a one-line MPM_EINPUT /
  * MPM_EINTERNAL message; ASan/UBSan and the leak checker find the rest.

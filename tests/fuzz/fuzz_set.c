@@ -1,3 +1,4 @@
+/* floor: scene */
 /* libFuzzer harness: the --set override parser. Each input line is one
  * "key=value" override (split at the first '=' as the command line does)
  * applied by the scene loader to a fixed small scene (a box on a collider

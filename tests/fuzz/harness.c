@@ -1,3 +1,4 @@
+/* floor: core */
 #include "tests/fuzz/harness.h"
 
 #include "core/error.h"
@@ -25,10 +26,7 @@ const char *fuzz_write_input(const uint8_t *data, size_t size, const char *suffi
 
 void fuzz_setup(void)
 {
-    omp_set_num_threads(1);
-#ifdef MPM_SCENE_DIR
-    setenv("MPM_SCENE_DIR", MPM_SCENE_DIR, 0);
-#endif
+    omp_set_num_threads(1); /* the built-in scenes are found beside the binary (core/scene/data_dir.h) */
 }
 
 void fuzz_require_message(int status, const char *what)

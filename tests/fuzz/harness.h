@@ -1,3 +1,4 @@
+/* floor: core */
 /* Shared by the libFuzzer harnesses (tests/fuzz/fuzz_*.c): the loaders read
  * files, so each input is written to one scratch file per process, in
  * tmpfs when there is one. */

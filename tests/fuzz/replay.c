@@ -1,3 +1,4 @@
+/* floor: core */
 /* Replays libFuzzer inputs through a harness without libFuzzer: every file
  * given (or found in a directory given) is passed to LLVMFuzzerTestOneInput
  * once, in name order. CTest runs it over each target's seed corpus and its

@@ -1,3 +1,4 @@
+/* floor: app */
 /* Experiment-matrix internals (experiments/matrix_*.c):
  *  - numbers print as the shortest text that reads back as the same double;
  *  - CSV fields with commas, quotes and newlines survive csv_put + csv_parse,

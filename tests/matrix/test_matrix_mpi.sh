@@ -5,13 +5,10 @@
 # equal a serial run's, row for row in everything but times. One cell uses
 # BoomerAMG, whose adapter calls MPI_Init in the child: the child must start
 # as an MPI singleton of its own (the launcher's variables scrubbed), not
-# join the runner's job. Skipped when mpirun is missing.
+# join the runner's job. Skipped (exit 77) when mpirun is missing.
 . "$(dirname "$0")/../common/shell_harness.sh"
 
-if ! command -v mpirun >/dev/null; then
-  echo "mpirun not found (Debian package openmpi-bin): distributed matrix test skipped"
-  exit 0
-fi
+command -v mpirun >/dev/null || skip "mpirun not found (Debian package openmpi-bin)"
 cat >"$tmp/m.json" <<'EOF'
 {"name": "mpi", "defaults": {"scene": "stretched-box", "scale": 5, "frames": 1, "threads": 1},
  "axes": {"solver": ["hot", "pn-pcg", "pn-amg-pcg", "lbfgs-h"], "eps": [1e-7, 1e-8]}}

@@ -1,3 +1,4 @@
+/* floor: scene */
 /* The scene fields of Gast et al. 2015 section 6 options: absent, they
  * keep the defaults (APIC, forward Euler, shape volumes, frictionless
  * colliders); each bad value is a one-line MPM_EINPUT naming the field and

@@ -1,3 +1,4 @@
+/* floor: scene */
 /* OBJ meshes as solids: loading (all face-index forms, orientation), volume,
  * inside/outside and distance against analytic shapes, the lenient loader,
  * and every input error. The meshes are generated here under /tmp. */

@@ -1,3 +1,4 @@
+/* floor: scene */
 /* Samplers: Poisson minimum distance (tile and cut, across tile seams),
  * realised density 0.868 ppc per dx^3 within 5%, determinism for a seed,
  * random and lattice counts, surface points (on the surface, spread by

@@ -1,3 +1,4 @@
+/* floor: scene */
 /* The scene loader's behaviour on scene text written by the test itself
  * (fields kept, defaults, particle counts, masses, --set, --scale, initial
  * F), the listing of built-ins, and bad input (each a one-line MPM_EINPUT

@@ -1,3 +1,4 @@
+/* floor: scene */
 /* The scene options of the stress suite (core/scene/scene_load.h): initial_F "diagonal"
  * and "inverted_fraction", per-object "stiffness_variation" (checkerboard and
  * random), their validation, and particle ids (core/particles.h) surviving
@@ -9,6 +10,7 @@
 #include "core/error.h"
 #include "core/grid.h"
 #include "core/scene/scene_load.h"
+#include "tests/common/scene_fixture.h"
 #include "tests/common/testutil.h"
 
 /* A 0.3 m box of soft material, dx 0.02 (about 3.4k particles). */

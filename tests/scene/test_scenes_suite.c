@@ -1,9 +1,10 @@
+/* floor: scene */
 /* The paper's scene suite (HOT, Wang et al. 2020; docs/scenes.md §4, hot-scenes.md):
  * every built-in scene loads and validates at a coarse scale; particle
  * counts at --scale 1 are within 15 % of the paper's Table 2 (for Boards
  * the initial count, for Sauce the emitted total); the "-mesh" variants fail
  * with a one-line MPM_EINPUT naming the mesh when the asset directory lacks
- * it (and load from $MPM_MESH_DIR when it is set); particle sources
+ * it (test_mesh_assets loads them from $MPM_MESH_DIR); particle sources
  * (expected count, determinism, nothing outside the emission window,
  * particle properties, plastic state, moving sources, their colliders, the
  * step_end hook); collider oscillation, material velocity and CFL speed;
@@ -595,35 +596,6 @@ static void test_surface_particles(void)
     remove(obj);
 }
 
-/* With the original meshes (never required; their folder in the environment
- * variable MPM_MESH_DIR): the -mesh variants load. */
-static void test_mesh_assets(void)
-{
-    const char *dir = getenv("MPM_MESH_DIR");
-    if (!dir || !dir[0]) {
-        printf("mesh assets: MPM_MESH_DIR is not set, the -mesh variants are skipped\n");
-        return;
-    }
-    char probe[512];
-    snprintf(probe, sizeof probe, "%s/turkey.obj", dir);
-    if (access(probe, R_OK) != 0) {
-        printf("mesh assets: %s absent, skipped\n", dir);
-        return;
-    }
-    Scene s;
-    SceneLoadOptions opt = {.scale = 3.0, .asset_dir = dir};
-    double t0 = now();
-    mpm_clear_error();
-    int st = scene_load("sauce-mesh", &opt, &s);
-    CHECK(st == 0, "sauce-mesh with --asset-dir: %s", mpm_last_error());
-    if (st) return;
-    double inside[3] = {3, 3.4, 3}, outside[3] = {3, 3.9, 3};
-    CHECK(collider_phi(&s.colliders[0], 0, inside, NULL) < 0 && collider_phi(&s.colliders[0], 0, outside, NULL) > 0,
-          "turkey mesh collider placed at +(3, 3, 3)");
-    printf("mesh assets: sauce-mesh loads with --asset-dir %s (%.2f s)\n", dir, now() - t0);
-    scene_free(&s);
-}
-
 int main(void)
 {
     test_collider_extras();
@@ -631,7 +603,6 @@ int main(void)
     test_source_emission();
     test_step_hook();
     test_builtins();
-    test_mesh_assets();
     test_counts();
     return test_summary("test_scenes_suite");
 }

@@ -1,3 +1,4 @@
+/* floor: scene */
 /* Shapes: SDF signs and values of every primitive, CSG, transforms, bounds,
  * volumes against closed forms, and parse errors. */
 #include <jansson.h>

@@ -1,3 +1,4 @@
+/* floor: scene */
 /* Gast et al. 2015's three snowball scenes (Fig. 14, 17, 16): each is a
  * built-in, loads at --scale 1 with the particle count its description
  * states (the paper's 2.8e5 per ball) and at its benchmark scale with about

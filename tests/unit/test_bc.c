@@ -1,3 +1,4 @@
+/* floor: driver */
 /* Boundary conditions (SPEC 2 item 3): with no elastic and no body force, a
  * sticky node ends the step with exactly the prescribed velocity, a slip
  * node loses exactly the normal component of its velocity relative to the

@@ -1,3 +1,4 @@
+/* floor: core */
 /* The coloured traversal of particle blocks (core/block_traversal.h) on
  * particles spread over many blocks of every colour, some blocks full and
  * some with a single particle, at negative and positive coordinates:

@@ -1,3 +1,4 @@
+/* floor: core */
 /* The sparsity-pattern id (bsr_update_pattern_id), which tells
  * factorisations and AMG setups when to redo their symbolic phase: the
  * same for the same pattern whatever the values and the thread count,

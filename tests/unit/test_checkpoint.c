@@ -1,3 +1,4 @@
+/* floor: app */
 /* Checkpoints (experiments/io/checkpoint.h) restart a simulation bit for bit:
  * a run of frames 0..N and a run restarted from the checkpoint written at the
  * start of frame k give identical steps from k on (t, dt, residual, outer and

@@ -1,3 +1,4 @@
+/* floor: scene */
 /* Colliders: phase integration (bar3 top cap: 180 deg at 0.5 s, frozen
  * after 1 s), velocity field omega x r + v, removed phases, max speed,
  * normals, and parse errors. */

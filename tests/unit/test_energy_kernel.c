@@ -1,3 +1,4 @@
+/* floor: scene */
 /* The line search's kernels: problem_energy (F(dv), SVD, psi, P per particle,
  * four particles in SIMD lanes, core/fcr4.h) and problem_gradient (by cells,
  * core/gradient_cell.h), for every variant the dispatch can choose (AUTO:
@@ -39,6 +40,7 @@
 #include "core/gradient_cell.h"
 #include "core/problem.h"
 #include "tests/common/fixture.h"
+#include "tests/common/scene_fixture.h"
 #include "tests/common/testutil.h"
 
 static double urand(unsigned long long *s)

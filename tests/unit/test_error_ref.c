@@ -1,3 +1,4 @@
+/* floor: app */
 /* needs: MPM_WITH_CHOLMOD */
 /* Per-step solver error (experiments/accuracy/error_ref.h, SPEC 11):
  *  - the reference against itself gives err_h = e_gap = err_v_max = 0 (< 1e-9);

@@ -1,3 +1,4 @@
+/* floor: core */
 /* The event log (core/event_log.h), deadlines (core/deadline.h) and the
  * table of step phases (core/step_phases.h): registration by name (the same
  * name gives the same id, bad names and parents are refused), call counts of

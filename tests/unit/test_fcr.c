@@ -1,3 +1,4 @@
+/* floor: core */
 /* Fixed-corotated model: P against psi and dP/dF against P by central finite
  * differences; projected dP/dF symmetric PSD (GSL eigenvalues), equal to the
  * unprojected one where that is already SPD and equal to its eigenvalue clamp

@@ -1,3 +1,4 @@
+/* floor: driver */
 /* Coulomb friction at slip colliders (Stomakhin et al. 2013 section 8;
  * Gast et al. 2015 section 5.1), applied to the grid velocity after the
  * solve:
@@ -26,6 +27,7 @@
 #include "core/step.h"
 #include "core/scene/scene_load.h"
 #include "experiments/driver/registry.h"
+#include "tests/common/scene_fixture.h"
 #include "tests/common/testutil.h"
 
 static void random_unit(unsigned long long *rs, double n[3])

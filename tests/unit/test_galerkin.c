@@ -1,3 +1,4 @@
+/* floor: solvers */
 /* Galerkin consistency of the node-embedding hierarchy (HOT §4.1, eq. 6-8;
  * SPEC 6): for the fine Hessian H = M + dt^2 K of a real step problem,
  *   R H P = R M P + dt^2 K_c,

@@ -1,3 +1,4 @@
+/* floor: scene */
 /* The Hessian cell kernel (core/hessian_cell.c):
  *  - against the plain triple sum K_st = sum_p s_p a_ps^T A_p a_pt on random
  *    particles, for particle counts across the kernel's chunk of 8 (1, 7, 8,
@@ -14,6 +15,7 @@
 #include "core/hessian_cell.h"
 #include "core/problem.h"
 #include "tests/common/fixture.h"
+#include "tests/common/scene_fixture.h"
 #include "tests/common/testutil.h"
 
 static double urand(unsigned long long *s)

@@ -1,3 +1,4 @@
+/* floor: solvers */
 /* The shared backtracking line search (SPEC 5, solvers/backtracking.c) on a real
  * step problem (tests/common/fixture.c), along a steepest-descent direction long
  * enough that alpha = 1 overshoots:

@@ -1,3 +1,4 @@
+/* floor: solvers */
 /* Node-embedding Galerkin multigrid (SPEC 6; reference §5.1-5.4):
  * transfers (partition of unity, R = P^T, coarse ordering), the sparse
  * Galerkin product (matches P^T A P applied to vectors, exactly symmetric,

@@ -1,3 +1,4 @@
+/* floor: solvers */
 /* MINRES (solvers/krylov/minres.c) on small dense symmetric INDEFINITE systems
  * A = Q diag(lambda) Q^T (eigenvalues of both signs, Q a random orthogonal
  * matrix), against a dense Gaussian-elimination solve:

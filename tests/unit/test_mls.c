@@ -1,3 +1,4 @@
+/* floor: core */
 /* MLS-MPM transfers (SPEC 9; Hu et al. 2018 and its supplement):
  *  - the MLS gradient substitute in the stencils equals w_ip 4/dx^2 (x_i - x_p)
  *    computed directly from the node positions;

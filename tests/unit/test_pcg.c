@@ -1,3 +1,4 @@
+/* floor: solvers */
 /* PCG (SPEC 5) with block and scalar Jacobi on synthetic SPD block matrices:
  * convergence to tolerance, projection, the forcing-term and relative stops, the cap,
  * non-positive curvature, singular diagonal blocks, determinism, and flexible

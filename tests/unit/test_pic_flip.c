@@ -1,3 +1,4 @@
+/* floor: core */
 /* The PIC/FLIP transfer (Stomakhin et al. 2013; Gast et al. 2015 section
  * 6.1 step 5) against references computed here from the stencil weights:
  *  - alpha = 0 is PIC: v_p = sum w v_i^{n+1} (to round-off), C_p = 0, and x_p

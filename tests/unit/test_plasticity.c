@@ -1,3 +1,4 @@
+/* floor: core */
 /* Plasticity: von Mises return map lands on the yield surface, keeps U, V and
  * (to second order) J, leaves elastic states bitwise alone; snow clamp bounds
  * and Jp update; plasticity_apply dispatch and error handling. */

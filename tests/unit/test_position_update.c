@@ -1,3 +1,4 @@
+/* floor: scene */
 /* Backward-Euler particle positions (Gast et al. 2015 section 6.3):
  *  - a test built for the paper's argument: a lattice block moves at 1 m/s
  *    onto a resting sticky ground with dt = 2 dx / v. Where the whole
@@ -23,6 +24,7 @@
 #include "core/step.h"
 #include "core/scene/scene_load.h"
 #include "tests/common/fixture.h"
+#include "tests/common/scene_fixture.h"
 #include "tests/common/testutil.h"
 
 static const char *k_block =

@@ -1,3 +1,4 @@
+/* floor: core */
 /* The step problem's derivatives and products (SPEC 3, 4):
  *  - gradient of E against central differences of E;
  *  - Hessian-vector products (assembled and matrix-free, unprojected tangent)

@@ -1,3 +1,4 @@
+/* floor: core */
 /* The parallel particle sort (core/radix_sort.c, issue 21) gives exactly the
  * permutation of a qsort on (key, index), at 1 and at 2 threads: random
  * 64-bit keys, keys with many duplicates (a few distinct values, and

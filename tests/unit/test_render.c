@@ -1,3 +1,4 @@
+/* floor: app */
 /* PNG pictures: a small two-material scene with a sphere collider is
  * written, read back with libpng, and checked for size, content (both
  * material colours, collider grey, background), determinism and bad input. */

@@ -1,3 +1,4 @@
+/* floor: scene */
 /* Core robustness (issue 12): the error module (first message wins,
  * context prefixes, per-thread messages, messages from OpenMP workers),
  * sums independent of the thread count, thread-count parsing, the box tree

@@ -1,3 +1,4 @@
+/* floor: app */
 /* The run layer's contracts (issue 12 items 2, 3, 9):
  *  - a numerical breakdown inside a solve (MPM_ENUMERIC) becomes the step's
  *    status failed with the message as reason, the error buffer is cleared,

@@ -1,3 +1,4 @@
+/* floor: app */
 /* The one table of run settings (experiments/cli/run_settings.c) and the
  * one command-line parser (experiments/cli/cli.c), driven by the tables
  * themselves so that a new table line is tested without a new test:

@@ -1,3 +1,4 @@
+/* floor: solvers */
 /* Coloured symmetric block Gauss-Seidel (HOT reference §5.2): the operator
  * (D+U)^-1 D (D+L)^-1 in processing order is symmetric and positive, matches
  * a serial reference, is bitwise reproducible across runs and thread counts,

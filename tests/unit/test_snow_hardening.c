@@ -1,3 +1,4 @@
+/* floor: scene */
 /* The snow model of Stomakhin et al. 2013 as Gast et al. 2015 use it:
  * fixed corotated on the elastic F with mu = mu0 exp(xi (1 - J_p)),
  * lambda = lambda0 exp(xi (1 - J_p)) (Stomakhin Eq. 2), singular values of
@@ -26,6 +27,7 @@
 #include "core/plasticity.h"
 #include "core/step.h"
 #include "core/scene/scene_load.h"
+#include "tests/common/scene_fixture.h"
 #include "tests/common/testutil.h"
 
 static const char *k_snow =

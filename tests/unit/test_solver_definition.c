@@ -1,3 +1,4 @@
+/* floor: driver */
 /* A solver's resolved definition (solvers/solver_definition.h):
  *  - the text is "outer=", "inverse=", then every consulted option with its
  *    value in effect, sorted by key, one a line;

@@ -1,3 +1,4 @@
+/* floor: core */
 /* The stencil weights and gradients rebuilt from the 1D factors
  * (stencil_weights, core/grid.h) against the quadratic B-spline evaluated
  * node by node from its piecewise definition (SPEC 1), and the node ids

@@ -1,3 +1,4 @@
+/* floor: solvers */
 /* The Newton-decrement stopping rule (SPEC 4.1) on a quadratic fixture
  * q(x) = 1/2 x^T A x + c^T x (A a synthetic SPD block matrix with Dirichlet
  * nodes, c projected):

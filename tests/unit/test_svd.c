@@ -1,3 +1,4 @@
+/* floor: core */
 /* svd3: reconstruction, orthogonality, det +1, sort/sign convention, on random,
  * inverted, rank-deficient, repeated, near-degenerate and extreme-scale inputs. */
 #include "core/mat3.h"

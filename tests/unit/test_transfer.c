@@ -1,3 +1,4 @@
+/* floor: core */
 /* P2G/G2P with APIC conserve mass, linear and angular momentum when no force
  * acts (Jiang et al. 2015): P2G -> G2P (dt = 0, grid velocities unchanged) ->
  * P2G gives back the same grid momentum and angular momentum. The grid

@@ -1,3 +1,4 @@
+/* floor: core */
 /* P2G through block-local arenas (core/transfer_blocked.c) against the plain
  * kernels of core/transfer.c on a jittered two-material lattice spanning
  * many 4x4x4 blocks: the MLS fused P2G and the APIC P2G with the explicit

@@ -1,3 +1,4 @@
+/* floor: scene */
 /* Particle volumes from the grid density (Gast et al. 2015 section 6.1 step
  * 2): on a uniform lattice of ppc = 8 particles per cell (spacing dx/2) the
  * quadratic B-spline sums to 2 per axis over the lattice, so m_i = 8 m_p at
@@ -13,6 +14,7 @@
 #include "core/error.h"
 #include "core/step.h"
 #include "core/scene/scene_load.h"
+#include "tests/common/scene_fixture.h"
 #include "tests/common/testutil.h"
 
 static const char *k_cube =

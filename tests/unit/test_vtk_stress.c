@@ -1,3 +1,4 @@
+/* floor: app */
 /* The stress measure of the ParaView output (experiments/run/vtk.h): the von
  * Mises stress of the fixed-corotated Cauchy stress. For F = diag(s) the
  * Cauchy stress is diagonal, sigma_i = 2 mu (s_i - 1) s_i / J + lambda (J - 1)
