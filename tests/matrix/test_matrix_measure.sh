@@ -38,7 +38,7 @@ import json, sys
 m = json.load(open(sys.argv[1]))
 m["repeat"] = 2
 del m["exclude"]
-m["scenes"]["drop"]["max_run_seconds"] = 1.5
+m["scenes"]["drop"]["max_run_seconds"] = 1e-6  # any step exhausts it, on any machine
 json.dump(m, open(sys.argv[1], "w"))
 PY
 "$bin" matrix run "$tmp/m.json" --out "$tmp/res" >"$tmp/run.txt" 2>"$tmp/run.err"
