@@ -248,7 +248,7 @@ static int amg_create(SolverOptions *opt, InvApprox **out)
     s->cheby_order = cheby_order;
     s->rbm_qmax = rbm_qmax;
     s->base.ops = &inv_boomeramg_ops;
-    s->base.caps = INV_NEEDS_MATRIX | INV_SYMMETRIC | INV_POSITIVE;
+    s->base.caps = INV_NEEDS_HESSIAN | INV_SYMMETRIC | INV_POSITIVE;
 #ifndef HYPRE_USING_OPENMP
     /* hypre's setup and V-cycle run on one thread (the matrix conversion
      * before them is OpenMP-parallel) */

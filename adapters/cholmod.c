@@ -77,7 +77,7 @@ static int chol_create(SolverOptions *opt, InvApprox **out)
      * own printing is silenced: every failure is reported via mpm_error(). */
     s->c.print = 0;
     s->base.ops = &inv_cholmod_ops;
-    s->base.caps = INV_NEEDS_MATRIX | INV_SYMMETRIC | INV_POSITIVE;
+    s->base.caps = INV_NEEDS_HESSIAN | INV_SYMMETRIC | INV_POSITIVE;
     /* the supernodal factorisation and solves run in the BLAS: OpenBLAS's
      * own thread count when it is the BLAS loaded (else unknown: 0, the
      * run's OpenMP threads, is reported) */

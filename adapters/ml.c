@@ -136,7 +136,7 @@ static int ml_create(SolverOptions *opt, InvApprox **out)
     s->damping = damping;
     s->rbm = r;
     s->base.ops = &inv_ml_ops;
-    s->base.caps = INV_NEEDS_MATRIX | INV_SYMMETRIC | INV_POSITIVE;
+    s->base.caps = INV_NEEDS_HESSIAN | INV_SYMMETRIC | INV_POSITIVE;
     /* ML's set-up runs on one thread; its V-cycle's fine-level products are
      * the project's OpenMP matvec (the coarse levels are serial) */
     s->base.setup_threads = 1;

@@ -166,7 +166,7 @@ void inv_caps_describe(unsigned caps, char *buf, size_t len)
     static const struct {
         unsigned flag;
         const char *text;
-    } names[] = {{INV_NEEDS_MATRIX, "needs the assembled matrix"}, {INV_MATRIX_FREE, "works matrix-free"},
+    } names[] = {{INV_NEEDS_HESSIAN, "needs the assembled Hessian"}, {INV_MATRIX_FREE, "works matrix-free"},
                  {INV_NEEDS_PROBLEM, "needs the step problem"},    {INV_VARIABLE, "variable"},
                  {INV_SYMMETRIC, "symmetric"},                     {INV_POSITIVE, "positive"},
                  {INV_INNER_ITERS, "inner iterations"}};

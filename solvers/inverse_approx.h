@@ -26,7 +26,7 @@
 #include "core/event_log.h"
 #include "core/node_order.h"
 #include "solvers/krylov/linear_op.h"
-#include "solvers/options.h"
+#include "solvers/solver_options.h"
 
 struct StepProblem;
 
@@ -47,7 +47,7 @@ typedef struct {
 
 /* Capability flags (InvApprox.caps, set by create from the options). */
 enum {
-    INV_NEEDS_MATRIX = 1u << 0,  /* setup reads InvSetupInput.H: refused when it is NULL */
+    INV_NEEDS_HESSIAN = 1u << 0,  /* setup reads InvSetupInput.H: refused when it is NULL */
     INV_MATRIX_FREE = 1u << 1,   /* works from diag, op and proj alone (H may be NULL) */
     INV_NEEDS_PROBLEM = 1u << 2, /* setup reads InvSetupInput.problem (rediscretisation) */
     INV_VARIABLE = 1u << 3,      /* apply is not a fixed linear map (an adaptive inner solve) */
@@ -184,7 +184,7 @@ void inv_view(const InvApprox *M, FILE *f, InvView *out);
 void inv_destroy(InvApprox *M);
 /* Inner iterations since creation (across setups). */
 long inv_inner_iters(const InvApprox *M);
-/* "needs the assembled matrix, variable, ..." for listings. */
+/* "needs the assembled Hessian, variable, ..." for listings. */
 void inv_caps_describe(unsigned caps, char *buf, size_t len);
 
 #endif

@@ -58,7 +58,7 @@
 #include "solvers/krylov/minres.h"
 #include "solvers/krylov/pcg.h"
 #include "solvers/line_search.h"
-#include "solvers/options.h"
+#include "solvers/solver_options.h"
 #include "solvers/stop_rule.h"
 
 /* Ordered by severity (a frame reports its worst step). */
@@ -118,7 +118,7 @@ typedef struct {
 struct OuterMethod {
     const OuterMethodOps *ops;
     /* sets its inverse approximation up from the assembled Hessian; 0 =
-     * matrix-free (an inverse approximation with INV_NEEDS_MATRIX is then
+     * matrix-free (an inverse approximation with INV_NEEDS_HESSIAN is then
      * refused when the solver is created) */
     int assembled;
 };

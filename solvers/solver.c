@@ -54,7 +54,7 @@ int solver_create(const char *name, const OuterMethodOps *outer, const InvApprox
     if (!st) st = outer->create(&s->opts, &s->outer);
     if (!st) s->outer->ops = outer;
     if (!st) st = inv_create(inverse, &s->opts, &s->inv);
-    if (!st && (s->inv->caps & INV_NEEDS_MATRIX) && !s->outer->assembled)
+    if (!st && (s->inv->caps & INV_NEEDS_HESSIAN) && !s->outer->assembled)
         st = mpm_error(MPM_EINPUT,
                        "solver %s: inverse approximation '%s' needs the assembled Hessian, which outer method '%s' "
                        "does not build (matrix-free)",

@@ -81,7 +81,7 @@ static int sgs_create(SolverOptions *opt, InvApprox **out)
     Sgs *S = calloc(1, sizeof *S);
     if (!S) return mpm_error(MPM_EINTERNAL, "out of memory: sgs");
     S->base.ops = &inv_sgs_ops;
-    S->base.caps = INV_NEEDS_MATRIX | INV_SYMMETRIC | INV_POSITIVE;
+    S->base.caps = INV_NEEDS_HESSIAN | INV_SYMMETRIC | INV_POSITIVE;
     *out = &S->base;
     return MPM_OK;
 }

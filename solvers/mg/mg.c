@@ -182,7 +182,7 @@ static int mg_create(SolverOptions *opt, InvApprox **out)
     /* the adaptive coarsest PCG makes the V-cycle vary with its input (to
      * 1e-12 with coarse_exact=1: then symmetric, as tests/unit/test_mg.c checks);
      * outer PCG uses flexible CG unless flexible=0 (the reference's plain PCG) */
-    M->base.caps = INV_NEEDS_MATRIX | INV_POSITIVE | INV_INNER_ITERS | (rediscretize ? INV_NEEDS_PROBLEM : 0u) |
+    M->base.caps = INV_NEEDS_HESSIAN | INV_POSITIVE | INV_INNER_ITERS | (rediscretize ? INV_NEEDS_PROBLEM : 0u) |
                    (exact ? INV_SYMMETRIC : INV_VARIABLE);
     M->base.flexible = flexible && levels > 1;
     *out = &M->base;

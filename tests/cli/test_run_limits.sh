@@ -89,7 +89,7 @@ expect_input_error "--out .*afile'?: exists and is not a directory" run --scene 
 # --- compositions ---
 "$bin" list solvers >"$tmp/list"
 check "list solvers: outer methods" grep -q "^  lbfgs " "$tmp/list"
-check "list solvers: inverse approximations with capabilities" grep -q "^  sgs .*needs the assembled matrix" "$tmp/list"
+check "list solvers: inverse approximations with capabilities" grep -q "^  sgs .*needs the assembled Hessian" "$tmp/list"
 expect_input_error "pn:sgs:matrix_free=1: inverse approximation 'sgs' needs the assembled Hessian.*outer method 'pn'" run --scene drop --solver pn:sgs:matrix_free=1
 expect_input_error "unknown inverse approximation 'nosuch' \(registered: block-jacobi" run --scene drop --solver pn:nosuch
 expect_input_error "unknown outer method 'newton'" run --scene drop --solver newton:sgs

@@ -271,7 +271,7 @@ static void check_create(const AdapterRow *row, const InvApproxOps *ops, Problem
     CHECK(!strcmp(ops->name, row->name), "inv_%s_ops is named '%s'", row->name, ops->name);
     InvApprox *M = ready(ops, "", &p);
     if (!M) return;
-    CHECK(M->ops == ops && (M->caps & INV_NEEDS_MATRIX), "%s: ops and caps (0x%x)", row->name, M->caps);
+    CHECK(M->ops == ops && (M->caps & INV_NEEDS_HESSIAN), "%s: ops and caps (0x%x)", row->name, M->caps);
     if (row->hierarchy) {
         int levels = 0;
         double cx = 0.0;

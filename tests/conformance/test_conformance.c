@@ -163,8 +163,8 @@ static void check_inverse(const InvCase *c, Problem *A, Problem *B)
     CHECK(st == MPM_OK, "%s: create without a step problem: %s", who, mpm_last_error());
     if (st) return;
     const unsigned caps = M->caps;
-    CHECK(!(caps & INV_NEEDS_MATRIX) != !(caps & INV_MATRIX_FREE),
-          "%s: exactly one of 'needs the assembled matrix' and 'works matrix-free' (caps %#x)", who, caps);
+    CHECK(!(caps & INV_NEEDS_HESSIAN) != !(caps & INV_MATRIX_FREE),
+          "%s: exactly one of 'needs the assembled Hessian' and 'works matrix-free' (caps %#x)", who, caps);
     CHECK(!((caps & INV_SYMMETRIC) && (caps & INV_VARIABLE)), "%s: claims symmetric and variable", who);
     CHECK(c->ops->view && c->ops->description && c->ops->description[0], "%s: has a view op and a description", who);
 
@@ -432,7 +432,7 @@ static void outer_methods(Problem *P)
                 ++refused;
                 continue;
             }
-            CHECK(!((s->inv->caps & INV_NEEDS_MATRIX) && !s->outer->assembled), "%s: unfit pair accepted", name);
+            CHECK(!((s->inv->caps & INV_NEEDS_HESSIAN) && !s->outer->assembled), "%s: unfit pair accepted", name);
             check_solver(s, name, outer->flags, P);
             solver_destroy(s);
             ++pairs;

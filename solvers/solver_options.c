@@ -1,4 +1,4 @@
-#include "solvers/options.h"
+#include "solvers/solver_options.h"
 
 #include <math.h>
 #include <stdio.h>
