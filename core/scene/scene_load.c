@@ -24,6 +24,7 @@
 #include "core/scene/sampler.h"
 #include "core/scene/shape.h"
 #include "core/scene/source_load.h"
+#include "core/transfer.h"
 
 const char *scene_dir(void)
 {
@@ -916,6 +917,17 @@ static int parse_sources(Scene *sc, json_t *srcs, const char *file, const char *
  * Top level
  * ====================================================================== */
 
+/* What "transfer" may be: every name of core/transfer.h's table, or the
+ * object form of PIC/FLIP. */
+static void transfer_expected(char *out, size_t n)
+{
+    size_t len = (size_t)snprintf(out, n, "expected ");
+    for (int i = 0; transfer_names[i] && len < n; ++i)
+        len += (size_t)snprintf(out + len, n - len, "\"%s\", ", transfer_names[i]);
+    if (len >= 2 && len < n)
+        snprintf(out + len - 2, n - len + 2, " or {\"type\": \"%s\", \"alpha\": a}", transfer_kind_name(TRANSFER_PIC_FLIP));
+}
+
 /* The MPM variants of Gast et al. 2015 section 6 (each off by default):
  * "transfer", "position_update", "particle_volume". */
 static int parse_mpm_options(json_t *root, const char *file, Scene *sc)
@@ -929,22 +941,23 @@ static int parse_mpm_options(json_t *root, const char *file, Scene *sc)
         static const char *const tkeys[] = {"type", "alpha", NULL};
         if ((st = sj_check_object(tj, file, "transfer", tkeys))) return st;
         if ((st = sj_string(tj, "type", 1, file, "transfer", &s, NULL))) return st;
-        if (strcmp(s, "pic_flip") != 0)
-            return sj_bad(file, "transfer", "type", "expected \"pic_flip\" (the object form is for PIC/FLIP)",
-                          json_object_get(tj, "type"));
+        TransferKind kind;
+        if (!transfer_kind_from_name(s, &kind) || kind != TRANSFER_PIC_FLIP) {
+            char what[96];
+            snprintf(what, sizeof what, "expected \"%s\" (the object form is for PIC/FLIP)",
+                     transfer_kind_name(TRANSFER_PIC_FLIP));
+            return sj_bad(file, "transfer", "type", what, json_object_get(tj, "type"));
+        }
         sc->transfer = TRANSFER_PIC_FLIP;
         if ((st = sj_number(tj, "alpha", 0, file, "transfer", &sc->flip_alpha, NULL))) return st;
         if (!(sc->flip_alpha >= 0 && sc->flip_alpha <= 1))
             return sj_bad_number(file, "transfer", "alpha", "expected a number in [0, 1]", sc->flip_alpha);
     } else if (tj) {
-        if (json_is_string(tj) && strcmp(json_string_value(tj), "pic_flip") == 0)
-            sc->transfer = TRANSFER_PIC_FLIP;
-        else if (json_is_string(tj) && strcmp(json_string_value(tj), "mls") == 0)
-            sc->transfer = TRANSFER_MLS;
-        else if (!json_is_string(tj) || strcmp(json_string_value(tj), "apic") != 0)
-            return sj_bad(file, "", "transfer",
-                          "expected \"apic\", \"mls\", \"pic_flip\" or {\"type\": \"pic_flip\", \"alpha\": a}",
-                          tj);
+        if (!json_is_string(tj) || !transfer_kind_from_name(json_string_value(tj), &sc->transfer)) {
+            char what[256];
+            transfer_expected(what, sizeof what);
+            return sj_bad(file, "", "transfer", what, tj);
+        }
     }
     sc->position_update = POSITION_FORWARD_EULER;
     if ((st = sj_string(root, "position_update", 0, file, "", &s, &have))) return st;

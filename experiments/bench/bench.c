@@ -263,7 +263,7 @@ int bench_run(const char *what, const RunConfig *cfg)
                           .advect = 1};
     int all = !strcmp(what, "all");
     double min_s = 1.0;
-    const char *tname = scene->transfer == TRANSFER_MLS ? "mls" : scene->transfer == TRANSFER_APIC ? "apic" : "pic_flip";
+    const char *tname = transfer_kind_name(scene->transfer);
 
     printf("bench on %s (transfer %s): %zu particles, %d active nodes, %lld blocks (%.1f per row), %d thread%s\n",
            scene->name, tname, np, n, (long long)H.nnzb, (double)H.nnzb / n, threads, threads == 1 ? "" : "s");

@@ -10,7 +10,8 @@
  *   p2g, g2p  the MLS-MPM supplement's transfer kernels (section 3: P2G with
  *             the force from F, linear elasticity, and the normalisation;
  *             G2P with the F update and advection), APIC or MLS by the
- *             scene's "transfer" (--transfer apic|mls);
+ *             scene's "transfer" (--transfer apic|mls|pic_flip; PIC/FLIP's
+ *             P2G is APIC's);
  *   all       every one.
  * Each kernel line gives particles/s, the model's minimum bytes and flops
  * per particle, GB/s and GFLOP/s, their fractions of STREAM and of the peak,

@@ -149,8 +149,9 @@ void cli_wrap(FILE *f, int col, int at, const char *text)
 /* "  --flag VALUE" padded to a column, then the help and the allowed values. */
 static void usage_line(const Option *o, int show_key, FILE *f)
 {
-    char head[96], want[256], text[1024];
-    snprintf(head, sizeof head, "  %s%s%s", o->flag, o->metavar ? " " : "", o->metavar ? o->metavar : "");
+    char head[96], want[256], text[1024], value[64];
+    option_metavar(o, value, sizeof value);
+    snprintf(head, sizeof head, "  %s%s%s", o->flag, value[0] ? " " : "", value);
     fprintf(f, "%-*s", USAGE_COLUMN, head);
     if ((int)strlen(head) >= USAGE_COLUMN) fprintf(f, "\n%*s", USAGE_COLUMN, "");
     size_t len = (size_t)snprintf(text, sizeof text, "%s", o->help);
@@ -168,7 +169,9 @@ void cli_synopsis(const Command *cmd, FILE *f)
     if (cmd->operand) fprintf(f, " %s", cmd->operand);
     for (int r = 0; cmd->required && cmd->required[r]; ++r) {
         const Option *o = cli_find(cmd, cmd->required[r], NULL);
-        fprintf(f, " %s%s%s", cmd->required[r], o && o->metavar ? " " : "", o && o->metavar ? o->metavar : "");
+        char value[64] = "";
+        if (o) option_metavar(o, value, sizeof value);
+        fprintf(f, " %s%s%s", cmd->required[r], value[0] ? " " : "", value);
     }
     if (cmd->n_groups) fprintf(f, " [options]");
 }

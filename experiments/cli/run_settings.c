@@ -73,7 +73,7 @@ const Option run_settings[] = {
      OPT_MIN_OPEN | MATRIX_ALL | OPT_ID_GIVEN, "a step's solve past S seconds ends as timeout; the run goes on"},
     {"--max-run-seconds", "max_run_seconds", "S", OPT_REAL, 0, 1e9, "seconds", NULL, F(max_run_s), 0, NULL,
      OPT_MIN_OPEN | MATRIX_ALL | OPT_ID_GIVEN, "past S seconds the running step ends as timeout and the run stops"},
-    {"--on-failure", "on_failure", "stop|continue", OPT_CHOICE, 0, 0, NULL, on_failure_names, F(on_failure), 0, NULL,
+    {"--on-failure", "on_failure", NULL, OPT_CHOICE, 0, 0, NULL, on_failure_names, F(on_failure), 0, NULL,
      MATRIX_ALL | OPT_ID_GIVEN, "after a failed step: end the run (default) or go on from the last iterate"},
     {"--dt-from", NULL, "RUN_DIR", OPT_TEXT, 0, 0, "a run directory", NULL, F(dt_from), 0, NULL, 0,
      "replay that run's time steps (a reference run made with --trajectory)"},

@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/scene/scene_load.h"
 #include "core/threads.h"
+#include "core/transfer.h"
 #include "experiments/bench/bench.h"
 #include "experiments/cli/run_settings.h"
 #include "experiments/matrix/matrix_cmd.h"
@@ -99,17 +100,15 @@ static const Command run_command = {
 /* ------------------------------------------------------------------ bench */
 
 static const char *const bench_what[] = {"spmv", "assemble", "tangent", "hessvec", "energy", "gradient", "p2g", "g2p", "all", NULL};
-static const char *const bench_transfers[] = {"apic", "mls", NULL};
-
 typedef struct {
     RunConfig run;
-    int transfer; /* index into bench_transfers; -1: the scene's */
+    int transfer; /* index into transfer_names (core/transfer.h); -1: the scene's */
     char transfer_set[32];
 } BenchArgs;
 
 static const Option bench_options[] = {
-    {"--transfer", NULL, "apic|mls", OPT_CHOICE, 0, 0, NULL, bench_transfers, offsetof(BenchArgs, transfer), 0, NULL,
-     0, "the P2G/G2P kernels of APIC or of MLS-MPM (the same as --set transfer=...; default: the scene's)"},
+    {"--transfer", NULL, NULL, OPT_CHOICE, 0, 0, NULL, transfer_names, offsetof(BenchArgs, transfer), 0, NULL, 0,
+     "the transfer whose P2G/G2P kernels run (the same as --set transfer=...; default: the scene's)"},
     {NULL}};
 
 /* the run settings the kernels use: the scene as `run` loads it, and the threads */
@@ -129,7 +128,7 @@ static int bench_cmd(void *args, const char *what, int *exit_code)
     (void)exit_code;
     BenchArgs *a = args;
     if (a->transfer >= 0) { /* --transfer X is --set transfer=X, given last */
-        snprintf(a->transfer_set, sizeof a->transfer_set, "transfer=%s", bench_transfers[a->transfer]);
+        snprintf(a->transfer_set, sizeof a->transfer_set, "transfer=%s", transfer_names[a->transfer]);
         if (a->run.n_set >= RUN_MAX_LIST) return mpm_error(MPM_EINPUT, "--set: more than %d values", RUN_MAX_LIST);
         a->run.set[a->run.n_set++] = a->transfer_set;
     }

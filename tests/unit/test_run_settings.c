@@ -92,7 +92,9 @@ static void table_well_formed(void)
     for (int k = 0; k < run_settings_count; ++k) {
         const Option *o = &run_settings[k];
         CHECK(o->flag && !strncmp(o->flag, "--", 2) && o->help && o->help[0], "line %d: flag and help", k);
-        CHECK((o->type == OPT_SWITCH) == (o->metavar == NULL), "%s: a value name unless a switch", o->flag);
+        char value[64];
+        option_metavar(o, value, sizeof value);
+        CHECK((o->type == OPT_SWITCH) == (value[0] == '\0'), "%s: a value name unless a switch", o->flag);
         CHECK(o->type != OPT_CHOICE || (o->choices && o->choices[0]), "%s: choices", o->flag);
         CHECK(o->type != OPT_LIST || o->count_offset != 0, "%s: a list needs its count", o->flag);
         for (int j = 0; j < k; ++j) {
