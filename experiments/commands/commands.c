@@ -58,7 +58,6 @@ static int list_run(void *args, const char *what, int *exit_code)
 
 static const Command list_command = {
     .name = "list",
-    .operand = "solvers|scenes|definitions",
     .operand_choices = list_what,
     .operand_missing = "'solvers', 'scenes' or 'definitions'",
     .summary = "The registered solvers (presets, outer methods, inverse approximations and their options, "
@@ -99,7 +98,6 @@ static const Command run_command = {
 
 /* ------------------------------------------------------------------ bench */
 
-static const char *const bench_what[] = {"spmv", "assemble", "tangent", "hessvec", "energy", "gradient", "p2g", "g2p", "all", NULL};
 typedef struct {
     RunConfig run;
     int transfer; /* index into transfer_names (core/transfer.h); -1: the scene's */
@@ -137,9 +135,7 @@ static int bench_cmd(void *args, const char *what, int *exit_code)
 
 static const Command bench_command = {
     .name = "bench",
-    .operand = "spmv|assemble|tangent|hessvec|energy|gradient|p2g|g2p|all",
-    .operand_choices = bench_what,
-    .operand_missing = "spmv, assemble, tangent, hessvec, energy, gradient, p2g, g2p or all",
+    .operand_choices = bench_operands,
     .required = bench_required,
     .summary = "Kernel throughput on a scene's first time step against the machine's limits measured in the same "
                "process (STREAM triad, FMA peak): block-CSR SpMV, matrix-free H x, Hessian assembly, the P2G and G2P "

@@ -375,7 +375,7 @@ static int parse_cmd(const Command *cmd, int argc, const char *const *args, void
 {
     char *all[8];
     int n = 0;
-    if (cmd->operand) all[n++] = (char *)(cmd->operand_choices ? cmd->operand_choices[0] : "operand");
+    if (cli_takes_operand(cmd)) all[n++] = (char *)(cmd->operand_choices ? cmd->operand_choices[0] : "operand");
     for (int i = 0; i < argc; ++i) all[n++] = (char *)args[i];
     const char *got;
     int help;
