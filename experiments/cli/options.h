@@ -16,6 +16,10 @@
 #define OPT_LIST_MAX 64   /* values of a repeatable option */
 #define OPT_INT_CAP 1000000000.0
 
+/* A macro's value as it is written ("1e-7"), for a default in a help text. */
+#define OPT_SPELLED(macro) OPT_SPELLED_TEXT(macro)
+#define OPT_SPELLED_TEXT(text) #text
+
 typedef enum {
     OPT_SWITCH, /* no value: the int field becomes 1 */
     OPT_INT,    /* int field: an integer in [min, max] (max 0: up to OPT_INT_CAP) */

@@ -18,9 +18,6 @@ static int check_solver(const char *spec) { return solver_spec_check(spec, NULL,
 static const char *const on_failure_names[] = {"stop", "continue", NULL}; /* FailurePolicy order */
 
 #define F(field) offsetof(RunConfig, field)
-/* A macro's value as the text it is written with (a default in a help line). */
-#define TEXT_OF(macro) SPELLING_OF(macro)
-#define SPELLING_OF(text) #text
 #define MATRIX_ALL (OPT_IN_DEFAULTS | OPT_IN_SCENES)
 
 /* Table order is the order of the help and of a cell's command line; the
@@ -34,7 +31,7 @@ const Option run_settings[] = {
      "preset (mpmbench list solvers) or OUTER:INVERSE[:key=value,...]"},
     {"--eps", "eps", "E", OPT_REAL, 0, 0, NULL, NULL, F(eps), 0, NULL,
      OPT_MIN_OPEN | OPT_IN_DEFAULTS | OPT_AXIS | OPT_ID_ALWAYS | OPT_ARGV_ALWAYS,
-     "tolerance of the characteristic-norm stopping rule (default " TEXT_OF(SOLVE_EPS_DEFAULT) ")"},
+     "tolerance of the characteristic-norm stopping rule (default " OPT_SPELLED(SOLVE_EPS_DEFAULT) ")"},
     {"--scale", "scale", "S", OPT_REAL, 0, 0, NULL, NULL, F(scale), 0, NULL,
      OPT_MIN_OPEN | MATRIX_ALL | OPT_AXIS | OPT_ID_ALWAYS | OPT_ARGV_ALWAYS,
      "grid spacing times S (particle counts scale as 1/S^3; default 1)"},

@@ -122,6 +122,7 @@
 #include <jansson.h>
 
 #include "experiments/cli/run_settings.h"
+#include "experiments/matrix/matrix_keys.h"
 
 #define MATRIX_MAX_KV 32       /* entries of one merged set / solver_opts */
 #define MATRIX_MAX_AXES 16     /* named axes */
@@ -195,7 +196,7 @@ typedef struct {
     char file[1024];          /* as given */
     char base[256];           /* file name without directories, for messages */
     char dir[1024];           /* directory of the file */
-    char name[64];
+    char name[MATRIX_NAME_MAX + 1];
     const char *description;  /* the file's text, whole (owned by root); "" when none */
     MatrixSettings defaults;
     MatrixAxis axis[RUN_SETTINGS_MAX]; /* axis[k]: of run_settings[k] (OPT_AXIS ones) */
