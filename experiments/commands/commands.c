@@ -148,8 +148,9 @@ static const Command bench_command = {
 
 /* ------------------------------------------------------------------ program */
 
-const Command *const cli_commands[] = {&list_command,       &run_command,           &bench_command, &render_command,
-                                       &matrix_run_command, &matrix_report_command, NULL};
+const Command *const cli_commands[] = {&list_command,       &run_command,           &bench_command,
+                                       &render_command,     &matrix_run_command,    &matrix_report_command,
+                                       &matrix_schema_command, NULL};
 
 const Command *cli_command(const char *name)
 {
@@ -214,11 +215,14 @@ static const Command *find_command(int argc, char **argv, int *words, int *statu
     char group[64], choices[256] = "";
     snprintf(group, sizeof group, "%s ", argv[1]);
     size_t len = 0;
-    int n = 0;
+    int n = 0, count = 0;
+    for (int i = 0; cli_commands[i]; ++i) count += !strncmp(cli_commands[i]->name, group, strlen(group));
     for (int i = 0; cli_commands[i]; ++i)
-        if (!strncmp(cli_commands[i]->name, group, strlen(group)) && len < sizeof choices)
-            len += (size_t)snprintf(choices + len, sizeof choices - len, "%s'%s'", n++ ? " or " : "",
-                                    cli_commands[i]->name + strlen(group));
+        if (!strncmp(cli_commands[i]->name, group, strlen(group)) && len < sizeof choices) {
+            const char *sep = n == 0 ? "" : n + 1 == count ? " or " : ", ";
+            len += (size_t)snprintf(choices + len, sizeof choices - len, "%s'%s'", sep, cli_commands[i]->name + strlen(group));
+            ++n;
+        }
     if (n && argc > 2 && help_wanted(argv[2])) return NULL; /* mpmbench matrix --help: the program's usage */
     if (!n) *status = mpm_error(MPM_EINPUT, "unknown command '%s' (see: mpmbench --help)", argv[1]);
     else if (argc < 3) *status = mpm_error(MPM_EINPUT, "%s: expected %s (see: mpmbench --help)", argv[1], choices);

@@ -362,11 +362,11 @@ static int get_list(const Matrix *m, json_t *v, const char *path, size_t *n)
 
 static int check_axis_name(const Matrix *m, const char *path, const char *name)
 {
-    int ok = name[0] >= 'a' && name[0] <= 'z' && strlen(name) < 64;
+    int ok = name[0] >= 'a' && name[0] <= 'z' && strlen(name) <= MATRIX_AXIS_NAME_MAX;
     for (const char *c = name; *c && ok; ++c) ok = islower((unsigned char)*c) || isdigit((unsigned char)*c) || *c == '_';
     if (!ok)
-        return mpm_error(MPM_EINPUT, "%s: %s: axis name \"%s\": expected [a-z][a-z0-9_]*, under 64 characters",
-                         m->base, path, name);
+        return mpm_error(MPM_EINPUT, "%s: %s: axis name \"%s\": expected [a-z][a-z0-9_]*, under %d characters",
+                         m->base, path, name, MATRIX_AXIS_NAME_MAX + 1);
     if (matrix_column_reserved(name))
         return mpm_error(MPM_EINPUT, "%s: %s: axis name \"%s\" is a built-in column name", m->base, path, name);
     if (matrix_named_index(m, name) >= 0)

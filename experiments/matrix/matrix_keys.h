@@ -10,6 +10,7 @@
 
 #define MATRIX_NAME_MAX 63          /* characters of a matrix's name */
 #define MATRIX_NAME_RULE "1-" OPT_SPELLED(MATRIX_NAME_MAX) " of A-Z a-z 0-9 _ - ." /* a name, in words */
+#define MATRIX_AXIS_NAME_MAX 63     /* characters of a named axis's name */
 #define MATRIX_REFERENCE_EPS 1e-10  /* a reference run's eps when it gives none */
 
 /* Where a key stands. */
