@@ -53,6 +53,14 @@ typedef enum {
                               the MLS substitute (stencils_use_mls_gradients), F <- (I + dt C'_p) F */
 } TransferKind;
 
+/* The scene file's name of each transfer ("transfer": "mls"), in the order
+ * messages list them; NULL-terminated (the table: core/transfer_kind.c). */
+extern const char *const transfer_names[];
+/* The kind a name means: 1, or 0 when it names none. */
+int transfer_kind_from_name(const char *name, TransferKind *kind);
+/* The name of a kind ("pic_flip"). */
+const char *transfer_kind_name(TransferKind kind);
+
 typedef struct {
     TransferKind kind;
     double apic_ratio; /* TRANSFER_APIC: r in [0, 1] (1 APIC, 0 RPIC) */

@@ -66,7 +66,7 @@ typedef enum { SOLVE_CONVERGED = 0, SOLVE_CAPPED, SOLVE_STALLED, SOLVE_TIMEOUT, 
 const char *solve_status_name(SolveStatus s);
 
 typedef struct {
-    double eps;           /* CN tolerance (SPEC 4), default 1e-7 */
+    double eps;           /* CN tolerance (SPEC 4), default SOLVE_EPS_DEFAULT (solver.h) */
     int max_outer;        /* 10000 */
     int max_linear;       /* 10000: PCG iterations per linear solve */
     int max_halvings;     /* 60 */

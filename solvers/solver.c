@@ -9,7 +9,7 @@
 void solve_settings_default(SolveSettings *s)
 {
     memset(s, 0, sizeof *s);
-    s->eps = 1e-7;
+    s->eps = SOLVE_EPS_DEFAULT;
     s->max_outer = 10000;
     s->max_linear = 10000;
     s->max_halvings = 60;

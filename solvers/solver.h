@@ -21,6 +21,10 @@
  * representable change of F, and the test compares rounding noise. */
 #define SOLVE_EPS_MIN (DBL_EPSILON / 24.0)
 
+/* The CN tolerance when none is given (SPEC 4; HOT's). The one place of this
+ * value: the run settings table prints it in --help as written here. */
+#define SOLVE_EPS_DEFAULT 1e-7
+
 /* MPM_EINPUT with one line naming the setting when a value is out of range
  * (eps below SOLVE_EPS_MIN, non-positive caps). */
 int solve_settings_check(const SolveSettings *s);

@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/scene/json_read.h"
+#include "core/scene/scene_keys.h"
 #include "core/scene/shape.h"
 
 #ifndef M_PI
@@ -108,12 +109,10 @@ static int parse_friction(json_t *j, const char *file, const char *path, Collide
 int collider_parse_named(json_t *j, const char *file, const char *jpath, const char *asset_dir, double dx,
                          const char *default_name, Collider *out)
 {
-    static const char *const keys[] = {"name",        "type",          "shape",     "pivot", "motion",
-                                       "oscillation", "material_velocity", "cfl_speed", "friction", NULL};
     Collider c;
     memset(&c, 0, sizeof c);
     memset(out, 0, sizeof *out);
-    int st = sj_check_object(j, file, jpath, keys);
+    int st = scene_keys_check(j, file, jpath, scene_collider_keys, 0);
     if (st) return st;
     const char *name = default_name ? default_name : "collider", *type = "sticky";
     if ((st = sj_string(j, "name", 0, file, jpath, &name, NULL))) return st;

@@ -22,8 +22,10 @@
 #include "core/scene/noise.h"
 #include "core/scene/rng.h"
 #include "core/scene/sampler.h"
+#include "core/scene/scene_keys.h"
 #include "core/scene/shape.h"
 #include "core/scene/source_load.h"
+#include "core/transfer.h"
 
 const char *scene_dir(void)
 {
@@ -117,27 +119,6 @@ int scene_list(SceneListFn fn, void *ctx)
  * Overrides
  * ====================================================================== */
 
-/* Optional fields that --set may create when absent, by context. */
-static const char *const k_top_optional[] = {"description", "cfl",          "max_dt",          "min_dt",
-                                             "cfl_rule",    "apic_ratio",   "domain_walls",    "seed",
-                                             "colliders",   "sources",      "transfer",        "position_update",
-                                             "particle_volume", NULL};
-static const char *const k_mat_optional[] = {"plasticity", NULL};
-static const char *const k_plast_optional[] = {"yield_stress", "theta_c", "theta_s", "hardening",
-                                               "min_Jp",       "max_Jp",  NULL};
-static const char *const k_obj_optional[] = {"name",      "sampling",          "velocity", "initial_F",
-                                             "variation", "surface_particles", "stiffness_variation", NULL};
-static const char *const k_col_optional[] = {"name",        "type",              "pivot",     "motion",
-                                             "oscillation", "material_velocity", "cfl_speed", "friction", NULL};
-static const char *const k_src_optional[] = {"name",        "from",     "until",           "pivot", "motion",
-                                             "oscillation", "collider", "particle_volume", NULL};
-
-static int in_list(const char *const *list, const char *s)
-{
-    for (; *list; ++list)
-        if (strcmp(*list, s) == 0) return 1;
-    return 0;
-}
 
 static int all_digits(const char *s)
 {
@@ -191,21 +172,21 @@ static int apply_override(json_t *root, const char *file, const SceneOverride *o
     char lp[512];
     sj_path(lp, sizeof lp, path, leaf);
     if (json_is_object(cur)) {
-        if (!json_object_get(cur, leaf)) {
-            const char *const *opt = NULL;
+        if (!json_object_get(cur, leaf)) { /* --set may add a key its object's table lets be absent */
+            const SceneKey *keys = NULL;
             if (nt == 1)
-                opt = k_top_optional;
+                keys = scene_top_keys;
             else if (nt == 3 && strcmp(tok[0], "materials") == 0)
-                opt = k_mat_optional;
+                keys = scene_material_keys;
             else if (nt == 4 && strcmp(tok[0], "materials") == 0 && strcmp(tok[2], "plasticity") == 0)
-                opt = k_plast_optional;
+                keys = scene_plasticity_keys;
             else if (nt == 3 && strcmp(tok[0], "objects") == 0)
-                opt = k_obj_optional;
+                keys = scene_object_keys;
             else if (nt == 3 && strcmp(tok[0], "colliders") == 0)
-                opt = k_col_optional;
+                keys = scene_collider_keys;
             else if (nt == 3 && strcmp(tok[0], "sources") == 0)
-                opt = k_src_optional;
-            if (!opt || !in_list(opt, leaf)) {
+                keys = scene_source_keys;
+            if (!keys || !scene_key_optional(keys, leaf)) {
                 json_decref(val);
                 return mpm_error(MPM_EINPUT, "%s: --set %s: %s does not exist", file, o->key, lp);
             }
@@ -246,8 +227,7 @@ static int read_name(json_t *obj, const char *key, int required, const char *fil
 
 static int parse_material(json_t *j, const char *name, const char *file, const char *path, Material *m)
 {
-    static const char *const keys[] = {"E", "nu", "density", "plasticity", NULL};
-    int st = sj_check_object(j, file, path, keys);
+    int st = scene_keys_check(j, file, path, scene_material_keys, 0);
     if (st) return st;
     memset(m, 0, sizeof *m);
     if (strlen(name) == 0 || strlen(name) >= sizeof m->name)
@@ -265,22 +245,17 @@ static int parse_material(json_t *j, const char *name, const char *file, const c
     if (pj) {
         char pp[512];
         sj_path(pp, sizeof pp, path, "plasticity");
-        static const char *const pkeys[] = {"type",    "yield_stress", "theta_c", "theta_s",
-                                            "hardening", "min_Jp",     "max_Jp",  NULL};
-        if ((st = sj_check_object(pj, file, pp, pkeys))) return st;
+        if ((st = scene_keys_check(pj, file, pp, scene_plasticity_keys, 0))) return st;
         const char *type = NULL;
         if ((st = sj_string(pj, "type", 1, file, pp, &type, NULL))) return st;
         if (strcmp(type, "none") == 0) {
-            static const char *const nk[] = {"type", NULL};
-            if ((st = sj_check_object(pj, file, pp, nk))) return st;
+            if ((st = scene_keys_check(pj, file, pp, scene_plasticity_keys, SCENE_PLASTICITY_NONE))) return st;
         } else if (strcmp(type, "von_mises") == 0) {
-            static const char *const vk[] = {"type", "yield_stress", NULL};
-            if ((st = sj_check_object(pj, file, pp, vk))) return st;
+            if ((st = scene_keys_check(pj, file, pp, scene_plasticity_keys, SCENE_PLASTICITY_VON_MISES))) return st;
             m->plasticity = PLASTICITY_VON_MISES;
             if ((st = sj_positive(pj, "yield_stress", 1, file, pp, &m->yield_stress, NULL))) return st;
         } else if (strcmp(type, "snow") == 0) {
-            static const char *const sk[] = {"type", "theta_c", "theta_s", "hardening", "min_Jp", "max_Jp", NULL};
-            if ((st = sj_check_object(pj, file, pp, sk))) return st;
+            if ((st = scene_keys_check(pj, file, pp, scene_plasticity_keys, SCENE_PLASTICITY_SNOW))) return st;
             m->plasticity = PLASTICITY_SNOW;
             if ((st = sj_number(pj, "theta_c", 1, file, pp, &m->theta_c, NULL))) return st;
             if (!(m->theta_c > 0 && m->theta_c < 1))
@@ -561,10 +536,7 @@ static void apply_stiffness_variations(Scene *sc, const ObjectSpec *objs, int no
 static int parse_object(json_t *j, const char *file, const char *path, uint64_t index, const Scene *sc,
                         const char *asset_dir, double scale, ObjectSpec *o)
 {
-    static const char *const keys[] = {"name",      "material",  "shape",          "ppc", "sampling",
-                                       "velocity",  "initial_F", "surface_particles", "variation",
-                                       "stiffness_variation", NULL};
-    int st = sj_check_object(j, file, path, keys);
+    int st = scene_keys_check(j, file, path, scene_object_keys, 0);
     if (st) return st;
     const char *s = NULL;
     char tmp[64];
@@ -916,6 +888,17 @@ static int parse_sources(Scene *sc, json_t *srcs, const char *file, const char *
  * Top level
  * ====================================================================== */
 
+/* What "transfer" may be: every name of core/transfer.h's table, or the
+ * object form of PIC/FLIP. */
+static void transfer_expected(char *out, size_t n)
+{
+    size_t len = (size_t)snprintf(out, n, "expected ");
+    for (int i = 0; transfer_names[i] && len < n; ++i)
+        len += (size_t)snprintf(out + len, n - len, "\"%s\", ", transfer_names[i]);
+    if (len >= 2 && len < n)
+        snprintf(out + len - 2, n - len + 2, " or {\"type\": \"%s\", \"alpha\": a}", transfer_kind_name(TRANSFER_PIC_FLIP));
+}
+
 /* The MPM variants of Gast et al. 2015 section 6 (each off by default):
  * "transfer", "position_update", "particle_volume". */
 static int parse_mpm_options(json_t *root, const char *file, Scene *sc)
@@ -929,22 +912,23 @@ static int parse_mpm_options(json_t *root, const char *file, Scene *sc)
         static const char *const tkeys[] = {"type", "alpha", NULL};
         if ((st = sj_check_object(tj, file, "transfer", tkeys))) return st;
         if ((st = sj_string(tj, "type", 1, file, "transfer", &s, NULL))) return st;
-        if (strcmp(s, "pic_flip") != 0)
-            return sj_bad(file, "transfer", "type", "expected \"pic_flip\" (the object form is for PIC/FLIP)",
-                          json_object_get(tj, "type"));
+        TransferKind kind;
+        if (!transfer_kind_from_name(s, &kind) || kind != TRANSFER_PIC_FLIP) {
+            char what[96];
+            snprintf(what, sizeof what, "expected \"%s\" (the object form is for PIC/FLIP)",
+                     transfer_kind_name(TRANSFER_PIC_FLIP));
+            return sj_bad(file, "transfer", "type", what, json_object_get(tj, "type"));
+        }
         sc->transfer = TRANSFER_PIC_FLIP;
         if ((st = sj_number(tj, "alpha", 0, file, "transfer", &sc->flip_alpha, NULL))) return st;
         if (!(sc->flip_alpha >= 0 && sc->flip_alpha <= 1))
             return sj_bad_number(file, "transfer", "alpha", "expected a number in [0, 1]", sc->flip_alpha);
     } else if (tj) {
-        if (json_is_string(tj) && strcmp(json_string_value(tj), "pic_flip") == 0)
-            sc->transfer = TRANSFER_PIC_FLIP;
-        else if (json_is_string(tj) && strcmp(json_string_value(tj), "mls") == 0)
-            sc->transfer = TRANSFER_MLS;
-        else if (!json_is_string(tj) || strcmp(json_string_value(tj), "apic") != 0)
-            return sj_bad(file, "", "transfer",
-                          "expected \"apic\", \"mls\", \"pic_flip\" or {\"type\": \"pic_flip\", \"alpha\": a}",
-                          tj);
+        if (!json_is_string(tj) || !transfer_kind_from_name(json_string_value(tj), &sc->transfer)) {
+            char what[256];
+            transfer_expected(what, sizeof what);
+            return sj_bad(file, "", "transfer", what, tj);
+        }
     }
     sc->position_update = POSITION_FORWARD_EULER;
     if ((st = sj_string(root, "position_update", 0, file, "", &s, &have))) return st;
@@ -1062,12 +1046,7 @@ static int parse_time_steps(json_t *root, const char *file, Scene *sc)
 
 static int build(json_t *root, const char *file, const SceneLoadOptions *opt, const char *asset_dir, Scene *sc)
 {
-    static const char *const keys[] = {"name",       "description", "dx",       "fps",          "frames",
-                                       "cfl",        "max_dt",      "min_dt",   "cfl_rule",     "gravity",
-                                       "apic_ratio", "domain",      "domain_walls", "seed",     "materials",
-                                       "objects",    "colliders",   "sources",  "transfer",     "position_update",
-                                       "particle_volume", NULL};
-    int st = sj_check_object(root, file, "", keys);
+    int st = scene_keys_check(root, file, "", scene_top_keys, 0);
     if (st) return st;
     if ((st = read_name(root, "name", 1, file, "", sc->name, sizeof sc->name))) return st;
     const char *desc = "";

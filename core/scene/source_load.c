@@ -10,6 +10,7 @@
 #include "core/mat3.h"
 #include "core/scene/collider_load.h"
 #include "core/scene/json_read.h"
+#include "core/scene/scene_keys.h"
 
 /* The collider JSON shared by the pose and the scene collider: shape, pivot,
  * motion and oscillation of the source, plus the outflow as material
@@ -93,12 +94,9 @@ int source_parse(json_t *j, const char *file, const char *jpath, const char *ass
                  const Material *mats, int n_mats, const PoissonTile *tile, const char *default_name,
                  Source *out, Collider *collider)
 {
-    static const char *const keys[] = {"name",  "material", "shape",       "ppc",      "velocity",
-                                       "from",  "until",    "pivot",       "motion",   "oscillation",
-                                       "collider", "particle_volume", NULL};
     memset(out, 0, sizeof *out);
     memset(collider, 0, sizeof *collider);
-    int st = sj_check_object(j, file, jpath, keys);
+    int st = scene_keys_check(j, file, jpath, scene_source_keys, 0);
     if (st) return st;
     Source s;
     memset(&s, 0, sizeof s);

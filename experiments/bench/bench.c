@@ -221,6 +221,134 @@ static void report(const Limits *L, KernelModel m, double t, double spread, cons
            gfl / L->peak_machine, key, gfl / L->peak_build, key, spread);
 }
 
+/* What the kernels' measurements share: the timed state, the scene, the
+ * machine's limits and the sizes the models scale with. */
+typedef struct {
+    BenchCtx *ctx;
+    const Scene *scene;
+    Limits L;
+    size_t mat_bytes;   /* the Hessian's storage */
+    double npp;         /* active nodes per particle */
+    double min_s;       /* seconds of repetitions per timing */
+} Bench;
+
+static int bench_spmv(Bench *b, const char *name)
+{
+    BenchCtx *bc = b->ctx;
+    int n = bc->sim->pb.n_nodes;
+    double spread = 0, ts, stream_gbs;
+    /* minimal traffic: matrix arrays once, x and y once */
+    double bytes = (double)b->mat_bytes + 2.0 * 24.0 * n;
+    double t = machine_best_time(run_spmv, bc, b->min_s, &spread);
+    double spmv_gbs = bytes / t / 1e9;
+    printf("%-28s %10.3f ms %11.2f GB/s\n", "block-CSR SpMV", 1e3 * t, spmv_gbs);
+    /* STREAM triad over a working set of the same size */
+    int status = machine_stream_triad((size_t)(bytes / 24.0), b->min_s, &ts, &stream_gbs);
+    if (status) return status;
+    printf("%-28s %10.3f ms %11.2f GB/s\n", "STREAM triad (same size)", 1e3 * ts, stream_gbs);
+    double tm = machine_best_time(run_hessvec, bc, b->min_s, NULL);
+    double mf_gbs_equiv = bytes / tm / 1e9;
+    printf("%-28s %10.3f ms %11.2fx SpMV time\n", "matrix-free H x", 1e3 * tm, tm / t);
+    (void)name; /* its figures have keys of their own */
+    printf("spmv_gbs=%.3f\nstream_gbs=%.3f\nspmv_stream_ratio=%.3f\nstream_dram_gbs=%.3f\n"
+           "spmv_stream_dram_ratio=%.3f\nhessvec_over_spmv_time=%.3f\n",
+           spmv_gbs, stream_gbs, spmv_gbs / stream_gbs, b->L.stream_gbs, spmv_gbs / b->L.stream_gbs,
+           spmv_gbs / mf_gbs_equiv);
+    return MPM_OK;
+}
+
+static int bench_hessvec(Bench *b, const char *name)
+{
+    double spread = 0;
+    double t = machine_best_time(run_hessvec, b->ctx, b->min_s, &spread);
+    report(&b->L, model_hessvec(b->npp), t, spread, name);
+    return MPM_OK;
+}
+
+static int bench_assemble(Bench *b, const char *name)
+{
+    BenchCtx *bc = b->ctx;
+    size_t np = b->L.np;
+    double spread = 0;
+    double t = machine_best_time(run_assemble, bc, b->min_s, &spread);
+    report(&b->L, model_assemble((double)bc->H->nnzb / (double)np), t, spread, name);
+    printf("%s_kernel_isa=%s\n", name, hessian_cell_isa());
+    problem_tangent(&bc->sim->pb, 1); /* the scatter alone reads stored tangents */
+    double t2 = machine_best_time(run_scatter, bc, b->min_s, NULL);
+    printf("%-28s %10.3f ms %10.3g p/s\nscatter_particles_per_s=%.4g\n", "assemble (scatter only)", 1e3 * t2,
+           np / t2, np / t2);
+    return MPM_OK;
+}
+
+static int bench_tangent(Bench *b, const char *name)
+{
+    double spread = 0;
+    double t = machine_best_time(run_tangent, b->ctx, b->min_s, &spread);
+    report(&b->L, model_tangent(ENERGY_SVD_TESTS, ENERGY_SVD_ROTATIONS), t, spread, name);
+    printf("%s_kernel_isa=%s\n", name, fcr4_isa());
+    return MPM_OK;
+}
+
+static int bench_energy(Bench *b, const char *name)
+{
+    BenchCtx *bc = b->ctx;
+    int n = bc->sim->pb.n_nodes;
+    double spread = 0;
+    /* a trial point off the initial guess, as a line search's: dv0 + 1e-3 x */
+    for (int i = 0; i < 3 * n; ++i) bc->y[i] = 1e-3 * bc->x[i];
+    problem_project(&bc->sim->pb, bc->y);
+    for (int i = 0; i < 3 * n; ++i) bc->dv[i] += bc->y[i];
+    double t = machine_best_time(run_energy, bc, b->min_s, &spread);
+    report(&b->L, model_energy(b->npp, ENERGY_SVD_TESTS, ENERGY_SVD_ROTATIONS), t, spread, name);
+    printf("%s_kernel_isa=%s\n", name, fcr4_isa());
+    return MPM_OK;
+}
+
+static int bench_gradient(Bench *b, const char *name)
+{
+    BenchCtx *bc = b->ctx;
+    size_t np = b->L.np;
+    const int *base = bc->sim->st.base;
+    double spread = 0;
+    problem_energy(&bc->sim->pb, bc->dv); /* the cache at dv */
+    double t = machine_best_time(run_gradient, bc, b->min_s, &spread);
+    size_t cells = np > 0; /* runs of one base node */
+    for (size_t k = 1; k < np; ++k) cells += memcmp(base + 3 * k, base + 3 * (k - 1), 3 * sizeof(int)) != 0;
+    report(&b->L, model_gradient(b->npp, cells ? (double)np / (double)cells : 1.0), t, spread, name);
+    printf("%s_kernel_isa=%s\n%s_particles_per_cell=%.2f\n", name, gradient_cell_isa(), name,
+           cells ? (double)np / (double)cells : 0.0);
+    return MPM_OK;
+}
+
+static int bench_p2g(Bench *b, const char *name)
+{
+    int mls = b->scene->transfer == TRANSFER_MLS;
+    double spread = 0;
+    double t = machine_best_time(run_p2g, b->ctx, b->min_s, &spread);
+    report(&b->L, model_p2g(mls, b->npp), t, spread, name);
+    KernelModel mb = model_p2g(mls, b->npp);
+    mb.name = mls ? "P2G blocked (MLS)" : "P2G blocked (APIC + force)";
+    t = machine_best_time(run_p2g_blocked, b->ctx, b->min_s, &spread);
+    char key[64];
+    snprintf(key, sizeof key, "%s_blocked", name);
+    report(&b->L, mb, t, spread, key);
+    return MPM_OK;
+}
+
+static int bench_g2p(Bench *b, const char *name)
+{
+    double spread = 0;
+    double t = machine_best_time(run_g2p, b->ctx, b->min_s, &spread);
+    report(&b->L, model_g2p(b->scene->transfer == TRANSFER_MLS, b->npp), t, spread, name);
+    return MPM_OK;
+}
+
+#define KERNEL_NAME(kernel) #kernel,
+#define KERNEL_RUN(kernel) bench_##kernel,
+const char *const bench_operands[] = {BENCH_KERNELS(KERNEL_NAME) "all", NULL};
+static int (*const kernel_run[])(Bench *b, const char *name) = {BENCH_KERNELS(KERNEL_RUN)};
+enum { N_KERNELS = sizeof kernel_run / sizeof kernel_run[0] };
+
 int bench_run(const char *what, const RunConfig *cfg)
 {
     const char *solver_opts[RUN_MAX_LIST + 1];
@@ -263,7 +391,7 @@ int bench_run(const char *what, const RunConfig *cfg)
                           .advect = 1};
     int all = !strcmp(what, "all");
     double min_s = 1.0;
-    const char *tname = scene->transfer == TRANSFER_MLS ? "mls" : scene->transfer == TRANSFER_APIC ? "apic" : "pic_flip";
+    const char *tname = transfer_kind_name(scene->transfer);
 
     printf("bench on %s (transfer %s): %zu particles, %d active nodes, %lld blocks (%.1f per row), %d thread%s\n",
            scene->name, tname, np, n, (long long)H.nnzb, (double)H.nnzb / n, threads, threads == 1 ? "" : "s");
@@ -281,74 +409,10 @@ int bench_run(const char *what, const RunConfig *cfg)
     printf("%-28s %10.3f ms %11.2f GB/s\n", "STREAM triad (384 MB)", 1e3 * ts, L.stream_gbs);
     printf("%-28s %11.2f GFLOP/s (%s); %.2f GFLOP/s with the build's instructions\n", "floating-point peak",
            peak.gflops_machine, peak.isa, peak.gflops_build);
-    double npp = (double)n / (double)np;
-    double spmv_gbs = 0, stream_gbs = 0, mf_gbs_equiv = 0, spread = 0;
-    if (all || !strcmp(what, "spmv")) {
-        /* minimal traffic: matrix arrays once, x and y once */
-        double bytes = (double)mat_bytes + 2.0 * 24.0 * n;
-        double t = machine_best_time(run_spmv, &bc, min_s, &spread);
-        spmv_gbs = bytes / t / 1e9;
-        printf("%-28s %10.3f ms %11.2f GB/s\n", "block-CSR SpMV", 1e3 * t, spmv_gbs);
-        /* STREAM triad over a working set of the same size */
-        if ((status = machine_stream_triad((size_t)(bytes / 24.0), min_s, &ts, &stream_gbs))) goto done;
-        printf("%-28s %10.3f ms %11.2f GB/s\n", "STREAM triad (same size)", 1e3 * ts, stream_gbs);
-        double tm = machine_best_time(run_hessvec, &bc, min_s, NULL);
-        mf_gbs_equiv = bytes / tm / 1e9;
-        printf("%-28s %10.3f ms %11.2fx SpMV time\n", "matrix-free H x", 1e3 * tm, tm / t);
-        printf("spmv_gbs=%.3f\nstream_gbs=%.3f\nspmv_stream_ratio=%.3f\nstream_dram_gbs=%.3f\n"
-               "spmv_stream_dram_ratio=%.3f\nhessvec_over_spmv_time=%.3f\n",
-               spmv_gbs, stream_gbs, spmv_gbs / stream_gbs, L.stream_gbs, spmv_gbs / L.stream_gbs,
-               spmv_gbs / mf_gbs_equiv);
-    }
-    if (all || !strcmp(what, "hessvec")) {
-        double t = machine_best_time(run_hessvec, &bc, min_s, &spread);
-        report(&L, model_hessvec(npp), t, spread, "hessvec");
-    }
-    if (all || !strcmp(what, "assemble")) {
-        double t = machine_best_time(run_assemble, &bc, min_s, &spread);
-        report(&L, model_assemble((double)H.nnzb / (double)np), t, spread, "assemble");
-        printf("assemble_kernel_isa=%s\n", hessian_cell_isa());
-        problem_tangent(pb, 1); /* the scatter alone reads stored tangents */
-        double t2 = machine_best_time(run_scatter, &bc, min_s, NULL);
-        printf("%-28s %10.3f ms %10.3g p/s\nscatter_particles_per_s=%.4g\n", "assemble (scatter only)", 1e3 * t2,
-               np / t2, np / t2);
-    }
-    if (all || !strcmp(what, "tangent")) {
-        double t = machine_best_time(run_tangent, &bc, min_s, &spread);
-        report(&L, model_tangent(ENERGY_SVD_TESTS, ENERGY_SVD_ROTATIONS), t, spread, "tangent");
-        printf("tangent_kernel_isa=%s\n", fcr4_isa());
-    }
-    if (all || !strcmp(what, "energy")) {
-        /* a trial point off the initial guess, as a line search's: dv0 + 1e-3 x */
-        for (int i = 0; i < 3 * n; ++i) bc.y[i] = 1e-3 * bc.x[i];
-        problem_project(pb, bc.y);
-        for (int i = 0; i < 3 * n; ++i) bc.dv[i] += bc.y[i];
-        double t = machine_best_time(run_energy, &bc, min_s, &spread);
-        report(&L, model_energy(npp, ENERGY_SVD_TESTS, ENERGY_SVD_ROTATIONS), t, spread, "energy");
-        printf("energy_kernel_isa=%s\n", fcr4_isa());
-    }
-    if (all || !strcmp(what, "gradient")) {
-        problem_energy(pb, bc.dv); /* the cache at dv */
-        double t = machine_best_time(run_gradient, &bc, min_s, &spread);
-        size_t cells = np > 0; /* runs of one base node */
-        for (size_t k = 1; k < np; ++k)
-            cells += memcmp(sim->st.base + 3 * k, sim->st.base + 3 * (k - 1), 3 * sizeof(int)) != 0;
-        report(&L, model_gradient(npp, cells ? (double)np / (double)cells : 1.0), t, spread, "gradient");
-        printf("gradient_kernel_isa=%s\ngradient_particles_per_cell=%.2f\n", gradient_cell_isa(),
-               cells ? (double)np / (double)cells : 0.0);
-    }
-    if (all || !strcmp(what, "p2g")) {
-        double t = machine_best_time(run_p2g, &bc, min_s, &spread);
-        report(&L, model_p2g(scene->transfer == TRANSFER_MLS, npp), t, spread, "p2g");
-        KernelModel mb = model_p2g(scene->transfer == TRANSFER_MLS, npp);
-        mb.name = scene->transfer == TRANSFER_MLS ? "P2G blocked (MLS)" : "P2G blocked (APIC + force)";
-        t = machine_best_time(run_p2g_blocked, &bc, min_s, &spread);
-        report(&L, mb, t, spread, "p2g_blocked");
-    }
-    if (all || !strcmp(what, "g2p")) {
-        double t = machine_best_time(run_g2p, &bc, min_s, &spread);
-        report(&L, model_g2p(scene->transfer == TRANSFER_MLS, npp), t, spread, "g2p");
-    }
+    Bench b = {.ctx = &bc, .scene = scene, .L = L, .mat_bytes = mat_bytes, .npp = (double)n / (double)np,
+               .min_s = min_s};
+    for (int k = 0; k < N_KERNELS; ++k)
+        if ((all || !strcmp(what, bench_operands[k])) && (status = kernel_run[k](&b, bench_operands[k]))) goto done;
     printf("particles=%zu\nactive_nodes=%d\nhessian_blocks=%lld\nhessian_bytes_per_node=%.1f\n", np, n,
            (long long)H.nnzb, (double)mat_bytes / n);
     printf("transfer=%s\nstream_dram_gbs=%.3f\npeak_gflops=%.3f\npeak_isa=%s\nbuild_peak_gflops=%.3f\nthreads=%d\n",

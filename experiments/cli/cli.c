@@ -44,6 +44,27 @@ const Option *cli_find(const Command *cmd, const char *flag, size_t *base)
     return &cmd->groups[gi].table[k];
 }
 
+int cli_takes_operand(const Command *cmd) { return cmd->operand || cmd->operand_choices; }
+
+/* The operand's name in the usage ("FILE", "spmv|hessvec|...|all"). */
+static void operand_name(const Command *cmd, char *out, size_t n)
+{
+    size_t len = (size_t)snprintf(out, n, "%s", cmd->operand ? cmd->operand : "");
+    for (int k = 0; !cmd->operand && cmd->operand_choices && cmd->operand_choices[k] && len < n; ++k)
+        len += (size_t)snprintf(out + len, n - len, "%s%s", k ? "|" : "", cmd->operand_choices[k]);
+}
+
+/* What a message says the operand should be ("a matrix file", "spmv, hessvec, ... or all"). */
+static void operand_expected(const Command *cmd, char *out, size_t n)
+{
+    size_t len = (size_t)snprintf(out, n, "%s", cmd->operand_missing ? cmd->operand_missing : "");
+    int count = 0;
+    while (!cmd->operand_missing && cmd->operand_choices && cmd->operand_choices[count]) ++count;
+    for (int k = 0; k < count && len < n; ++k)
+        len += (size_t)snprintf(out + len, n - len, "%s%s", k == 0 ? "" : k + 1 == count ? " or " : ", ",
+                                cmd->operand_choices[k]);
+}
+
 static int is_help(const char *a) { return !strcmp(a, "-h") || !strcmp(a, "--help"); }
 
 int cli_parse(const Command *cmd, int argc, char **argv, int first, void *args, const char **operand, int *help)
@@ -59,6 +80,9 @@ int cli_parse(const Command *cmd, int argc, char **argv, int first, void *args, 
         }
     unsigned long long given[CLI_MAX_GROUPS] = {0}; /* bit k of group g: its option k was given */
     int only_operands = 0;
+    char name[512], expected[512];
+    operand_name(cmd, name, sizeof name);
+    operand_expected(cmd, expected, sizeof expected);
     for (int i = first; i < argc; ++i) {
         const char *a = argv[i];
         if (!only_operands && !strcmp(a, "--")) {
@@ -66,11 +90,12 @@ int cli_parse(const Command *cmd, int argc, char **argv, int first, void *args, 
             continue;
         }
         if (only_operands || a[0] != '-' || !a[1]) { /* an operand */
-            if (!cmd->operand) return mpm_error(MPM_EINPUT, "%s: unexpected argument '%s' (see: mpmbench %s --help)",
-                                                cmd->name, a, cmd->name);
+            if (!cli_takes_operand(cmd))
+                return mpm_error(MPM_EINPUT, "%s: unexpected argument '%s' (see: mpmbench %s --help)", cmd->name, a,
+                                 cmd->name);
             if (*operand)
                 return mpm_error(MPM_EINPUT, "%s: one %s expected, got '%s' and '%s' (see: mpmbench %s --help)", cmd->name,
-                                 cmd->operand, *operand, a, cmd->name);
+                                 name, *operand, a, cmd->name);
             *operand = a;
             continue;
         }
@@ -106,13 +131,12 @@ int cli_parse(const Command *cmd, int argc, char **argv, int first, void *args, 
         if (st) return st;
         if (k < 64) given[gi] |= 1ull << k;
     }
-    if (cmd->operand && !*operand)
-        return mpm_error(MPM_EINPUT, "%s: expected %s (see: mpmbench %s --help)", cmd->name, cmd->operand_missing,
-                         cmd->name);
+    if (cli_takes_operand(cmd) && !*operand)
+        return mpm_error(MPM_EINPUT, "%s: expected %s (see: mpmbench %s --help)", cmd->name, expected, cmd->name);
     if (cmd->operand_choices) {
         int ok = 0;
         for (int k = 0; cmd->operand_choices[k] && !ok; ++k) ok = !strcmp(*operand, cmd->operand_choices[k]);
-        if (!ok) return mpm_error(MPM_EINPUT, "%s '%s': expected %s", cmd->name, *operand, cmd->operand_missing);
+        if (!ok) return mpm_error(MPM_EINPUT, "%s '%s': expected %s", cmd->name, *operand, expected);
     }
     for (int r = 0; cmd->required && cmd->required[r]; ++r) {
         int gi, k;
@@ -149,8 +173,9 @@ void cli_wrap(FILE *f, int col, int at, const char *text)
 /* "  --flag VALUE" padded to a column, then the help and the allowed values. */
 static void usage_line(const Option *o, int show_key, FILE *f)
 {
-    char head[96], want[256], text[1024];
-    snprintf(head, sizeof head, "  %s%s%s", o->flag, o->metavar ? " " : "", o->metavar ? o->metavar : "");
+    char head[96], want[256], text[1024], value[64];
+    option_metavar(o, value, sizeof value);
+    snprintf(head, sizeof head, "  %s%s%s", o->flag, value[0] ? " " : "", value);
     fprintf(f, "%-*s", USAGE_COLUMN, head);
     if ((int)strlen(head) >= USAGE_COLUMN) fprintf(f, "\n%*s", USAGE_COLUMN, "");
     size_t len = (size_t)snprintf(text, sizeof text, "%s", o->help);
@@ -165,10 +190,14 @@ static void usage_line(const Option *o, int show_key, FILE *f)
 void cli_synopsis(const Command *cmd, FILE *f)
 {
     fprintf(f, "mpmbench %s", cmd->name);
-    if (cmd->operand) fprintf(f, " %s", cmd->operand);
+    char name[512];
+    operand_name(cmd, name, sizeof name);
+    if (cli_takes_operand(cmd)) fprintf(f, " %s", name);
     for (int r = 0; cmd->required && cmd->required[r]; ++r) {
         const Option *o = cli_find(cmd, cmd->required[r], NULL);
-        fprintf(f, " %s%s%s", cmd->required[r], o && o->metavar ? " " : "", o && o->metavar ? o->metavar : "");
+        char value[64] = "";
+        if (o) option_metavar(o, value, sizeof value);
+        fprintf(f, " %s%s%s", cmd->required[r], value[0] ? " " : "", value);
     }
     if (cmd->n_groups) fprintf(f, " [options]");
 }

@@ -34,9 +34,11 @@ enum { CLI_EXIT_OK = 0, CLI_EXIT_INTERNAL = 1, CLI_EXIT_INPUT = 2, CLI_EXIT_CHEC
 
 typedef struct Command {
     const char *name;            /* "run", "matrix run" */
-    const char *operand;         /* the operand's name in the usage ("FILE", "solvers|scenes"), NULL: none */
+    const char *operand;         /* the operand's name in the usage ("FILE"); NULL: its choices joined
+                                    by '|', or no operand when it has no choices either */
     const char *const *operand_choices; /* allowed operands (NULL-terminated), NULL: any text */
-    const char *operand_missing; /* what the message says is missing: "a matrix file" */
+    const char *operand_missing; /* what the message says is missing: "a matrix file"; NULL: its
+                                    choices as "a, b or c" */
     const char *summary;         /* one line: what the command does */
     const char *notes;           /* more lines after the options (NULL: none) */
     const char *const *required; /* flags that must be given (NULL-terminated), NULL: none */
@@ -61,6 +63,9 @@ void cli_usage(const Command *cmd, FILE *f);
 void cli_synopsis(const Command *cmd, FILE *f);
 /* text as words from column `at` on, wrapping to lines that start at column col. */
 void cli_wrap(FILE *f, int col, int at, const char *text);
+
+/* Does cmd take an operand? */
+int cli_takes_operand(const Command *cmd);
 
 /* The option a flag names in cmd, NULL when none (for tests). */
 const Option *cli_find(const Command *cmd, const char *flag, size_t *base);

@@ -61,6 +61,14 @@ void option_expect(const Option *o, int quoted, char *out, size_t n)
     }
 }
 
+void option_metavar(const Option *o, char *out, size_t n)
+{
+    size_t len = (size_t)snprintf(out, n, "%s", o->metavar ? o->metavar : "");
+    if (o->metavar || o->type != OPT_CHOICE) return;
+    for (int k = 0; o->choices[k] && len < n; ++k)
+        len += (size_t)snprintf(out + len, n - len, "%s%s", k ? "|" : "", o->choices[k]);
+}
+
 int option_in_range(const Option *o, double x)
 {
     if (!isfinite(x)) return 0;

@@ -16,6 +16,10 @@
 #define OPT_LIST_MAX 64   /* values of a repeatable option */
 #define OPT_INT_CAP 1000000000.0
 
+/* A macro's value as it is written ("1e-7"), for a default in a help text. */
+#define OPT_SPELLED(macro) OPT_SPELLED_TEXT(macro)
+#define OPT_SPELLED_TEXT(text) #text
+
 typedef enum {
     OPT_SWITCH, /* no value: the int field becomes 1 */
     OPT_INT,    /* int field: an integer in [min, max] (max 0: up to OPT_INT_CAP) */
@@ -47,7 +51,8 @@ enum {
 typedef struct Option {
     const char *flag;                 /* "--eps" */
     const char *key;                  /* matrix-file key, NULL: none */
-    const char *metavar;              /* the value in the usage ("E"); NULL for a switch */
+    const char *metavar;              /* the value in the usage ("E"); NULL for a switch, and for a
+                                         choice whose usage lists its choices (option_metavar) */
     OptionType type;
     double min, max;                  /* OPT_INT, OPT_REAL, OPT_SIZE */
     const char *what;                 /* the value in words ("an integer number of threads"); NULL: by type */
@@ -71,6 +76,10 @@ typedef union {
 /* What the option accepts, in words: "an integer >= 1", "seconds in (0, 1e9]",
  * "stop or continue" (quoted: "\"stop\" or \"continue\"", for JSON files). */
 void option_expect(const Option *o, int quoted, char *out, size_t n);
+
+/* The value's name in the usage: the metavar, or a choice's values joined by
+ * '|' ("stop|continue"); "" for a switch. */
+void option_metavar(const Option *o, char *out, size_t n);
 
 /* The value of text for o into *v; MPM_EINPUT with one line
  * "FLAG 'TEXT': expected WHAT" otherwise (check's own message for a text

@@ -8,6 +8,7 @@
 #include "core/threads.h"
 #include "experiments/accuracy/error_ref.h"
 #include "experiments/driver/registry.h"
+#include "solvers/solver.h"
 
 _Static_assert(RUN_MAX_LIST == OPT_LIST_MAX, "RunConfig lists hold OPT_LIST_MAX values");
 _Static_assert(sizeof(FailurePolicy) == sizeof(int), "on_failure is set as an int");
@@ -30,7 +31,7 @@ const Option run_settings[] = {
      "preset (mpmbench list solvers) or OUTER:INVERSE[:key=value,...]"},
     {"--eps", "eps", "E", OPT_REAL, 0, 0, NULL, NULL, F(eps), 0, NULL,
      OPT_MIN_OPEN | OPT_IN_DEFAULTS | OPT_AXIS | OPT_ID_ALWAYS | OPT_ARGV_ALWAYS,
-     "tolerance of the characteristic-norm stopping rule (default 1e-7)"},
+     "tolerance of the characteristic-norm stopping rule (default " OPT_SPELLED(SOLVE_EPS_DEFAULT) ")"},
     {"--scale", "scale", "S", OPT_REAL, 0, 0, NULL, NULL, F(scale), 0, NULL,
      OPT_MIN_OPEN | MATRIX_ALL | OPT_AXIS | OPT_ID_ALWAYS | OPT_ARGV_ALWAYS,
      "grid spacing times S (particle counts scale as 1/S^3; default 1)"},
@@ -69,7 +70,7 @@ const Option run_settings[] = {
      OPT_MIN_OPEN | MATRIX_ALL | OPT_ID_GIVEN, "a step's solve past S seconds ends as timeout; the run goes on"},
     {"--max-run-seconds", "max_run_seconds", "S", OPT_REAL, 0, 1e9, "seconds", NULL, F(max_run_s), 0, NULL,
      OPT_MIN_OPEN | MATRIX_ALL | OPT_ID_GIVEN, "past S seconds the running step ends as timeout and the run stops"},
-    {"--on-failure", "on_failure", "stop|continue", OPT_CHOICE, 0, 0, NULL, on_failure_names, F(on_failure), 0, NULL,
+    {"--on-failure", "on_failure", NULL, OPT_CHOICE, 0, 0, NULL, on_failure_names, F(on_failure), 0, NULL,
      MATRIX_ALL | OPT_ID_GIVEN, "after a failed step: end the run (default) or go on from the last iterate"},
     {"--dt-from", NULL, "RUN_DIR", OPT_TEXT, 0, 0, "a run directory", NULL, F(dt_from), 0, NULL, 0,
      "replay that run's time steps (a reference run made with --trajectory)"},

@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/scene/scene_load.h"
 #include "core/threads.h"
+#include "core/transfer.h"
 #include "experiments/bench/bench.h"
 #include "experiments/cli/run_settings.h"
 #include "experiments/matrix/matrix_cmd.h"
@@ -57,7 +58,6 @@ static int list_run(void *args, const char *what, int *exit_code)
 
 static const Command list_command = {
     .name = "list",
-    .operand = "solvers|scenes|definitions",
     .operand_choices = list_what,
     .operand_missing = "'solvers', 'scenes' or 'definitions'",
     .summary = "The registered solvers (presets, outer methods, inverse approximations and their options, "
@@ -98,18 +98,15 @@ static const Command run_command = {
 
 /* ------------------------------------------------------------------ bench */
 
-static const char *const bench_what[] = {"spmv", "assemble", "tangent", "hessvec", "energy", "gradient", "p2g", "g2p", "all", NULL};
-static const char *const bench_transfers[] = {"apic", "mls", NULL};
-
 typedef struct {
     RunConfig run;
-    int transfer; /* index into bench_transfers; -1: the scene's */
+    int transfer; /* index into transfer_names (core/transfer.h); -1: the scene's */
     char transfer_set[32];
 } BenchArgs;
 
 static const Option bench_options[] = {
-    {"--transfer", NULL, "apic|mls", OPT_CHOICE, 0, 0, NULL, bench_transfers, offsetof(BenchArgs, transfer), 0, NULL,
-     0, "the P2G/G2P kernels of APIC or of MLS-MPM (the same as --set transfer=...; default: the scene's)"},
+    {"--transfer", NULL, NULL, OPT_CHOICE, 0, 0, NULL, transfer_names, offsetof(BenchArgs, transfer), 0, NULL, 0,
+     "the transfer whose P2G/G2P kernels run (the same as --set transfer=...; default: the scene's)"},
     {NULL}};
 
 /* the run settings the kernels use: the scene as `run` loads it, and the threads */
@@ -129,7 +126,7 @@ static int bench_cmd(void *args, const char *what, int *exit_code)
     (void)exit_code;
     BenchArgs *a = args;
     if (a->transfer >= 0) { /* --transfer X is --set transfer=X, given last */
-        snprintf(a->transfer_set, sizeof a->transfer_set, "transfer=%s", bench_transfers[a->transfer]);
+        snprintf(a->transfer_set, sizeof a->transfer_set, "transfer=%s", transfer_names[a->transfer]);
         if (a->run.n_set >= RUN_MAX_LIST) return mpm_error(MPM_EINPUT, "--set: more than %d values", RUN_MAX_LIST);
         a->run.set[a->run.n_set++] = a->transfer_set;
     }
@@ -138,9 +135,7 @@ static int bench_cmd(void *args, const char *what, int *exit_code)
 
 static const Command bench_command = {
     .name = "bench",
-    .operand = "spmv|assemble|tangent|hessvec|energy|gradient|p2g|g2p|all",
-    .operand_choices = bench_what,
-    .operand_missing = "spmv, assemble, tangent, hessvec, energy, gradient, p2g, g2p or all",
+    .operand_choices = bench_operands,
     .required = bench_required,
     .summary = "Kernel throughput on a scene's first time step against the machine's limits measured in the same "
                "process (STREAM triad, FMA peak): block-CSR SpMV, matrix-free H x, Hessian assembly, the P2G and G2P "
@@ -153,8 +148,9 @@ static const Command bench_command = {
 
 /* ------------------------------------------------------------------ program */
 
-const Command *const cli_commands[] = {&list_command,       &run_command,           &bench_command, &render_command,
-                                       &matrix_run_command, &matrix_report_command, NULL};
+const Command *const cli_commands[] = {&list_command,       &run_command,           &bench_command,
+                                       &render_command,     &matrix_run_command,    &matrix_report_command,
+                                       &matrix_schema_command, NULL};
 
 const Command *cli_command(const char *name)
 {
@@ -219,11 +215,14 @@ static const Command *find_command(int argc, char **argv, int *words, int *statu
     char group[64], choices[256] = "";
     snprintf(group, sizeof group, "%s ", argv[1]);
     size_t len = 0;
-    int n = 0;
+    int n = 0, count = 0;
+    for (int i = 0; cli_commands[i]; ++i) count += !strncmp(cli_commands[i]->name, group, strlen(group));
     for (int i = 0; cli_commands[i]; ++i)
-        if (!strncmp(cli_commands[i]->name, group, strlen(group)) && len < sizeof choices)
-            len += (size_t)snprintf(choices + len, sizeof choices - len, "%s'%s'", n++ ? " or " : "",
-                                    cli_commands[i]->name + strlen(group));
+        if (!strncmp(cli_commands[i]->name, group, strlen(group)) && len < sizeof choices) {
+            const char *sep = n == 0 ? "" : n + 1 == count ? " or " : ", ";
+            len += (size_t)snprintf(choices + len, sizeof choices - len, "%s'%s'", sep, cli_commands[i]->name + strlen(group));
+            ++n;
+        }
     if (n && argc > 2 && help_wanted(argv[2])) return NULL; /* mpmbench matrix --help: the program's usage */
     if (!n) *status = mpm_error(MPM_EINPUT, "unknown command '%s' (see: mpmbench --help)", argv[1]);
     else if (argc < 3) *status = mpm_error(MPM_EINPUT, "%s: expected %s (see: mpmbench --help)", argv[1], choices);

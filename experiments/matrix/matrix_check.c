@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "experiments/matrix/matrix_results.h"
 
 static void add(char *buf, size_t cap, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 static void add(char *buf, size_t cap, const char *fmt, ...)
@@ -208,9 +209,10 @@ int matrix_check_all(const Matrix *m, const MatrixCells *cells, const char *dir,
         csv_free(&t);
         return mpm_error(MPM_EINPUT, "%s: cannot write", path);
     }
-    fprintf(f, "id,scene,solver,eps");
+    for (int k = 0; k <= MATRIX_CHECK_LAST_SHARED; ++k) fprintf(f, "%s%s", k ? "," : "", matrix_columns[k].name);
     for (int a = 0; a < m->n_named; ++a) fprintf(f, ",%s", m->named[a].name);
-    fprintf(f, ",pass,reasons\n");
+    for (int k = 0; matrix_check_columns[k]; ++k) fprintf(f, ",%s", matrix_check_columns[k]);
+    fprintf(f, "\n");
     int cid = csv_col(&t, "id"), passed = 0;
     for (int i = 0; i < cells->n; ++i) {
         const MatrixCell *c = &cells->cells[i];
@@ -226,16 +228,16 @@ int matrix_check_all(const Matrix *m, const MatrixCells *cells, const char *dir,
         } else {
             matrix_check_cell(c, cdir, &t, row, &ck);
         }
-        char eps[32], line[4096];
-        matrix_format_number(c->run.eps, eps, sizeof eps);
+        char field[1100], line[4096];
         size_t len = 0;
         line[0] = '\0';
-        const char *fields[3] = {c->run.scene, c->run.solver, eps};
-        csv_put(line, sizeof line, &len, c->id);
-        for (int k = 0; k < 3; ++k) {
-            line[len++] = ',';
-            line[len] = '\0';
-            csv_put(line, sizeof line, &len, fields[k]);
+        for (int k = 0; k <= MATRIX_CHECK_LAST_SHARED; ++k) { /* cells.csv's first columns */
+            if (k) {
+                line[len++] = ',';
+                line[len] = '\0';
+            }
+            matrix_results_field(c, NULL, (MatrixColumn)k, field, sizeof field);
+            csv_put(line, sizeof line, &len, field);
         }
         for (int a = 0; a < m->n_named; ++a) {
             line[len++] = ',';

@@ -15,6 +15,7 @@
 #include "core/scene/data_dir.h"
 #include "core/threads.h"
 #include "experiments/matrix/matrix_run.h"
+#include "experiments/matrix/matrix_schema.h"
 
 #define O(field) offsetof(MatrixRunOptions, field)
 
@@ -184,3 +185,18 @@ const Command matrix_report_command = {
              "Exit status 0; 2 for a folder without cells.csv or matrix.json, or when no Python with matplotlib is\n"
              "found (one line naming what was tried).\n",
     .run = matrix_report_cmd};
+
+static int matrix_schema_cmd(void *args, const char *operand, int *exit_code)
+{
+    (void)args, (void)operand, (void)exit_code;
+    return matrix_schema_write(stdout);
+}
+
+const Command matrix_schema_command = {
+    .name = "matrix schema",
+    .summary = "Prints the JSON Schema of matrix files (docs/matrix.schema.json), generated from the run settings "
+               "table and the matrix file's own keys.",
+    .notes = "scripts/check_matrices.py validates files against the committed copy, which a test keeps equal\n"
+             "to this output: after changing a run setting or a matrix key, run\n"
+             "  mpmbench matrix schema > docs/matrix.schema.json\n",
+    .run = matrix_schema_cmd};

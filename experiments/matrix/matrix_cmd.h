@@ -1,7 +1,8 @@
-/* `mpmbench matrix run FILE` and `mpmbench matrix report DIR`: the commands
- * (experiments/cli/cli.h) of the experiment-matrix runner
- * (experiments/matrix/matrix_run.h) and of its report
- * (scripts/matrix_report.py). Their options and help are in matrix_cmd.c.
+/* `mpmbench matrix run FILE`, `mpmbench matrix report DIR` and `mpmbench
+ * matrix schema`: the commands (experiments/cli/cli.h) of the
+ * experiment-matrix runner (experiments/matrix/matrix_run.h), of its report
+ * (scripts/matrix_report.py) and of the matrix files' JSON Schema
+ * (matrix_schema.h). Their options and help are in matrix_cmd.c.
  *
  * The report runs with the first Python that can import matplotlib of
  * MPM_PYTHON (a program name looked up on PATH, or a path), the python3 on
@@ -16,5 +17,6 @@
 
 extern const Command matrix_run_command;
 extern const Command matrix_report_command;
+extern const Command matrix_schema_command;
 
 #endif

@@ -13,11 +13,8 @@
 #include "core/scene/scene_load.h"
 #include "experiments/accuracy/error_ref.h"
 #include "experiments/driver/registry.h"
-
-/* Column names of cells.csv a named axis may not take. */
-static const char *const g_reserved[] = {"id",          "scene",  "solver", "eps",      "scale",
-                                         "threads",     "frames_asked", "first_timed_frame", "set", "solver_opts",
-                                         "status",      "exit",   "error_ref", "role",   "reference"};
+#include "experiments/matrix/matrix_columns.h"
+#include "experiments/matrix/matrix_keys.h"
 
 void matrix_format_number(double v, char *out, size_t n)
 {
@@ -41,6 +38,12 @@ static int check_keys(const Matrix *m, json_t *obj, const char *path, const char
     return sj_check_object(obj, m->base, path, known);
 }
 
+/* The matrix's own keys at place (matrix_keys.c), after the n already in keys. */
+static void own_keys(MatrixKeyPlace place, const char **keys, int n, int cap)
+{
+    matrix_keys_at(place, keys + n, cap - n);
+}
+
 static int get_positive(const Matrix *m, json_t *v, const char *path, double *out)
 {
     if (!json_is_number(v) || !(json_number_value(v) > 0.0) || !isfinite(json_number_value(v)))
@@ -49,11 +52,13 @@ static int get_positive(const Matrix *m, json_t *v, const char *path, double *ou
     return MPM_OK;
 }
 
-static int get_int(const Matrix *m, json_t *v, const char *path, int lo, int *out)
+/* An integer key of the matrix's own, in its table line's range. */
+static int get_int(const Matrix *m, json_t *v, const char *path, const MatrixKey *key, int *out)
 {
     char want[64];
-    snprintf(want, sizeof want, "an integer >= %d", lo);
-    if (!json_is_integer(v) || json_integer_value(v) < lo || json_integer_value(v) > 1000000000)
+    if (key->max < OPT_INT_CAP) snprintf(want, sizeof want, "an integer %.0f..%.0f", key->min, key->max);
+    else snprintf(want, sizeof want, "an integer >= %.0f", key->min);
+    if (!json_is_integer(v) || json_integer_value(v) < key->min || json_integer_value(v) > key->max)
         return bad_value(m, path, v, want);
     *out = (int)json_integer_value(v);
     return MPM_OK;
@@ -253,10 +258,12 @@ static int get_kv(const Matrix *m, json_t *obj, const char *path, MatrixNamedKin
     return MPM_OK;
 }
 
-/* "reference": {"solver", "eps", "solver_opts", "set"} (false per scene: none). */
+/* "reference": a solver and optionally eps, solver options and --set
+ * overrides (matrix_keys.c; false per scene: none). */
 static int get_reference(Matrix *m, json_t *v, const char *path, int allow_false, MatrixReference *r)
 {
-    static const char *const keys[] = {"solver", "eps", "solver_opts", "set", NULL};
+    const char *keys[16];
+    own_keys(MATRIX_AT_REFERENCE, keys, 0, 16);
     memset(r, 0, sizeof *r);
     snprintf(r->origin, sizeof r->origin, "%s", path);
     if (allow_false && json_is_false(v)) return MPM_OK;
@@ -269,10 +276,12 @@ static int get_reference(Matrix *m, json_t *v, const char *path, int allow_false
     sj_path(p, sizeof p, path, "solver");
     if (!s) return mpm_error(MPM_EINPUT, "%s: %s: missing (required)", m->base, p);
     if ((st = get_solver(m, s, p, &r->solver)) || (st = keep(m, p, &r->solver_origin))) return st;
-    r->eps = 1e-10;
+    r->eps = MATRIX_REFERENCE_EPS;
     json_t *e = json_object_get(v, "eps");
     sj_path(p, sizeof p, path, "eps");
-    if (e && (st = get_positive(m, e, p, &r->eps))) return st;
+    OptionValue eps;
+    if (e && (st = get_setting(m, run_setting_by_key("eps"), e, p, &eps))) return st;
+    if (e) r->eps = eps.d;
     json_t *o = json_object_get(v, "solver_opts");
     sj_path(p, sizeof p, path, "solver_opts");
     if (o && (st = get_kv(m, o, p, MATRIX_SOLVER_OPTS, &r->solver_opts))) return st;
@@ -283,6 +292,8 @@ static int get_reference(Matrix *m, json_t *v, const char *path, int allow_false
     return MPM_OK;
 }
 
+#define SETTINGS_KEYS_MAX (RUN_SETTINGS_MAX + 8)
+
 /* The keys a settings object may have: every run setting with a key
  * allowed there, then the matrix's own keys. NULL-terminated. */
 static void settings_keys(int per_scene, const char **keys)
@@ -292,15 +303,15 @@ static void settings_keys(int per_scene, const char **keys)
         const Option *o = &run_settings[k];
         if (o->key && (o->flags & (per_scene ? OPT_IN_SCENES : OPT_IN_DEFAULTS))) keys[n++] = o->key;
     }
-    keys[n++] = "first_timed_frame";
-    if (per_scene) keys[n++] = "reference";
-    keys[n] = NULL;
+    own_keys(MATRIX_AT_SETTINGS, keys, n, SETTINGS_KEYS_MAX);
+    while (keys[n]) ++n;
+    if (per_scene) own_keys(MATRIX_AT_SCENE, keys, n, SETTINGS_KEYS_MAX);
 }
 
 /* "defaults" or a per-scene entry "scenes.NAME". */
 static int get_settings(Matrix *m, json_t *obj, const char *path, int per_scene, MatrixSettings *s)
 {
-    const char *keys[RUN_SETTINGS_MAX + 3];
+    const char *keys[SETTINGS_KEYS_MAX];
     settings_keys(per_scene, keys);
     if (!json_is_object(obj)) return bad_value(m, path, obj, "an object");
     int st = check_keys(m, obj, path, keys);
@@ -322,7 +333,7 @@ static int get_settings(Matrix *m, json_t *obj, const char *path, int per_scene,
                 s->given |= 1ull << k;
             }
         } else if (!strcmp(key, "first_timed_frame")) {
-            st = get_int(m, v, p, 0, &s->first_timed_frame);
+            st = get_int(m, v, p, matrix_key(MATRIX_AT_SETTINGS, key), &s->first_timed_frame);
             s->has_first = 1;
         } else if (!strcmp(key, "reference")) {
             st = get_reference(m, v, p, 1, &s->reference);
@@ -351,14 +362,13 @@ static int get_list(const Matrix *m, json_t *v, const char *path, size_t *n)
 
 static int check_axis_name(const Matrix *m, const char *path, const char *name)
 {
-    int ok = name[0] >= 'a' && name[0] <= 'z' && strlen(name) < 64;
+    int ok = name[0] >= 'a' && name[0] <= 'z' && strlen(name) <= MATRIX_AXIS_NAME_MAX;
     for (const char *c = name; *c && ok; ++c) ok = islower((unsigned char)*c) || isdigit((unsigned char)*c) || *c == '_';
     if (!ok)
-        return mpm_error(MPM_EINPUT, "%s: %s: axis name \"%s\": expected [a-z][a-z0-9_]*, under 64 characters",
-                         m->base, path, name);
-    for (size_t i = 0; i < sizeof g_reserved / sizeof g_reserved[0]; ++i)
-        if (!strcmp(name, g_reserved[i]))
-            return mpm_error(MPM_EINPUT, "%s: %s: axis name \"%s\" is a built-in column name", m->base, path, name);
+        return mpm_error(MPM_EINPUT, "%s: %s: axis name \"%s\": expected [a-z][a-z0-9_]*, under %d characters",
+                         m->base, path, name, MATRIX_AXIS_NAME_MAX + 1);
+    if (matrix_column_reserved(name))
+        return mpm_error(MPM_EINPUT, "%s: %s: axis name \"%s\" is a built-in column name", m->base, path, name);
     if (matrix_named_index(m, name) >= 0)
         return mpm_error(MPM_EINPUT, "%s: %s: axis name \"%s\" is used twice", m->base, path, name);
     return MPM_OK;
@@ -440,13 +450,11 @@ static int is_axis(int k) { return k >= 0 && (run_settings[k].flags & OPT_AXIS);
 
 static int get_axes(Matrix *m, json_t *axes)
 {
-    const char *keys[RUN_SETTINGS_MAX + 3];
+    const char *keys[SETTINGS_KEYS_MAX];
     int n_keys = 0;
     for (int k = 0; k < run_settings_count; ++k)
         if (is_axis(k)) keys[n_keys++] = run_settings[k].key;
-    keys[n_keys++] = "sets";
-    keys[n_keys++] = "solver_opts";
-    keys[n_keys] = NULL;
+    own_keys(MATRIX_AT_AXES, keys, n_keys, SETTINGS_KEYS_MAX);
     if (!json_is_object(axes)) return bad_value(m, "axes", axes, "an object");
     int st = check_keys(m, axes, "axes", keys);
     if (st) return st;
@@ -568,8 +576,8 @@ static int get_rules(Matrix *m, json_t *rules, const char *path)
 
 static int get_top(Matrix *m)
 {
-    static const char *const keys[] = {"name",     "description",    "defaults", "axes",      "scenes", "include",
-                                       "exclude",  "baseline",       "cell_timeout_s", "report", "reference", "repeat", NULL};
+    const char *keys[SETTINGS_KEYS_MAX];
+    own_keys(MATRIX_AT_TOP, keys, 0, SETTINGS_KEYS_MAX);
     json_t *root = m->root;
     m->description = "";
     m->repeat = 1;
@@ -581,7 +589,7 @@ static int get_top(Matrix *m)
     if ((st = get_string(m, v, "name", m->name, sizeof m->name))) return st;
     for (const char *c = m->name; *c; ++c)
         if (!isalnum((unsigned char)*c) && *c != '_' && *c != '-' && *c != '.')
-            return bad_value(m, "name", v, "1-63 of A-Z a-z 0-9 _ - .");
+            return bad_value(m, "name", v, MATRIX_NAME_RULE);
     if ((v = json_object_get(root, "description"))) {
         if (!json_is_string(v)) return bad_value(m, "description", v, "a string");
         m->description = json_string_value(v); /* any length: root keeps it */
@@ -636,13 +644,11 @@ static int get_top(Matrix *m)
     }
     if ((v = json_object_get(root, "cell_timeout_s")) && (st = get_positive(m, v, "cell_timeout_s", &m->cell_timeout_s)))
         return st;
-    if ((v = json_object_get(root, "repeat"))) {
-        if (!json_is_integer(v) || json_integer_value(v) < 1 || json_integer_value(v) > 100)
-            return bad_value(m, "repeat", v, "an integer 1..100");
-        m->repeat = (int)json_integer_value(v);
-    }
+    if ((v = json_object_get(root, "repeat")) && (st = get_int(m, v, "repeat", matrix_key(MATRIX_AT_TOP, "repeat"), &m->repeat)))
+        return st;
     if ((v = json_object_get(root, "report"))) {
-        static const char *const rk[] = {"mg_levels", NULL};
+        const char *rk[8];
+        own_keys(MATRIX_AT_REPORT, rk, 0, 8);
         if (!json_is_object(v)) return bad_value(m, "report", v, "an object");
         if ((st = check_keys(m, v, "report", rk))) return st;
         json_t *g = json_object_get(v, "mg_levels");

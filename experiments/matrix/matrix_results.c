@@ -42,23 +42,32 @@ static int put(char *out, size_t cap, size_t *len, const char *field, int first)
     return csv_put(out, cap, len, field);
 }
 
+int matrix_results_has(const Matrix *m, MatrixColumn k)
+{
+    switch (matrix_columns[k].when) {
+    case MATRIX_COL_WITH_ERROR_REF:
+        return m->uses_error_ref;
+    case MATRIX_COL_WITH_REPEAT:
+        return m->repeat > 1;
+    case MATRIX_COL_WITH_REFERENCES:
+        return m->has_references;
+    case MATRIX_COL_ALWAYS:
+        break;
+    }
+    return 1;
+}
+
 int matrix_results_header(const Matrix *m, char *out, size_t cap)
 {
     size_t len = 0;
     out[0] = '\0';
-    static const char *const fixed[] = {"id", "scene", "solver", "eps", "scale", "threads", "frames_asked",
-                                        "first_timed_frame"};
-    int bad = 0;
-    for (int i = 0; i < 8; ++i) bad |= put(out, cap, &len, fixed[i], i == 0);
-    if (m->uses_error_ref) bad |= put(out, cap, &len, "error_ref", 0);
-    for (int a = 0; a < m->n_named; ++a) bad |= put(out, cap, &len, m->named[a].name, 0);
-    if (m->repeat > 1) bad |= put(out, cap, &len, "repeat", 0);
-    if (m->has_references) {
-        bad |= put(out, cap, &len, "role", 0);
-        bad |= put(out, cap, &len, "reference", 0);
+    int bad = 0, first = 1;
+    for (int k = 0; k < MATRIX_COLS; ++k) {
+        if (!matrix_results_has(m, (MatrixColumn)k)) continue;
+        if (k != MATRIX_COL_NAMED_AXES) bad |= put(out, cap, &len, matrix_columns[k].name, first);
+        for (int a = 0; k == MATRIX_COL_NAMED_AXES && a < m->n_named; ++a) bad |= put(out, cap, &len, m->named[a].name, 0);
+        first = 0;
     }
-    bad |= put(out, cap, &len, "set", 0);
-    bad |= put(out, cap, &len, "solver_opts", 0);
     bad |= len + strlen(cell_measure_columns) + 2 >= cap;
     if (!bad) snprintf(out + len, cap - len, ",%s", cell_measure_columns);
     return bad ? mpm_error(MPM_EINPUT, "%s: too many columns", m->base) : MPM_OK;
@@ -72,36 +81,78 @@ static void kv_join(const MatrixKv *kv, int n, char *out, size_t cap)
         len += (size_t)snprintf(out + len, cap - len, "%s%s=%s", i ? ";" : "", kv[i].key, kv[i].value);
 }
 
+void matrix_results_field(const MatrixCell *c, const CellMeasure *x, MatrixColumn k, char *out, size_t cap)
+{
+    /* the counts the run used when the matrix left them to OpenMP / the scene (run.json) */
+    int threads = c->run.threads > 0 || !x || x->threads_run <= 0 ? c->run.threads : x->threads_run;
+    int frames = c->run.frames > 0 || !x || x->frames_run <= 0 ? c->run.frames : x->frames_run;
+    out[0] = '\0';
+    switch (k) {
+    case MATRIX_COL_ID:
+        snprintf(out, cap, "%s", c->id);
+        break;
+    case MATRIX_COL_SCENE:
+        snprintf(out, cap, "%s", c->run.scene);
+        break;
+    case MATRIX_COL_SOLVER:
+        snprintf(out, cap, "%s", c->run.solver);
+        break;
+    case MATRIX_COL_EPS:
+        matrix_format_number(c->run.eps, out, cap);
+        break;
+    case MATRIX_COL_SCALE:
+        matrix_format_number(c->run.scale, out, cap);
+        break;
+    case MATRIX_COL_THREADS:
+        snprintf(out, cap, "%d", threads);
+        break;
+    case MATRIX_COL_FRAMES_ASKED:
+        snprintf(out, cap, "%d", frames);
+        break;
+    case MATRIX_COL_FIRST_TIMED_FRAME:
+        snprintf(out, cap, "%d", c->first_timed_frame);
+        break;
+    case MATRIX_COL_ERROR_REF:
+        snprintf(out, cap, "%s", c->run.error_ref ? c->run.error_ref : "");
+        break;
+    case MATRIX_COL_REPEAT:
+        snprintf(out, cap, "%d", c->repeat);
+        break;
+    case MATRIX_COL_ROLE:
+        snprintf(out, cap, "%s", c->is_reference ? "reference" : "cell");
+        break;
+    case MATRIX_COL_REFERENCE:
+        snprintf(out, cap, "%s", c->ref_id);
+        break;
+    case MATRIX_COL_SET:
+        kv_join(c->set, c->n_set, out, cap);
+        break;
+    case MATRIX_COL_SOLVER_OPTS:
+        kv_join(c->solver_opts, c->n_solver_opts, out, cap);
+        break;
+    case MATRIX_COL_NAMED_AXES:
+    case MATRIX_COLS:
+        break;
+    }
+}
+
 int matrix_results_row(const Matrix *m, const MatrixCell *c, const CellOutcome *o, const CellMeasure *x, char *out,
                        size_t cap)
 {
     size_t len = 0;
-    char eps[32], scale[32], threads[16], frames[16], first[16], text[4096];
-    matrix_format_number(c->run.eps, eps, sizeof eps);
-    matrix_format_number(c->run.scale, scale, sizeof scale);
-    /* the counts the run used when the matrix left them to the scene / OpenMP (run.json) */
-    snprintf(threads, sizeof threads, "%d", c->run.threads > 0 || x->threads_run <= 0 ? c->run.threads : x->threads_run);
-    snprintf(frames, sizeof frames, "%d", c->run.frames > 0 || x->frames_run <= 0 ? c->run.frames : x->frames_run);
-    snprintf(first, sizeof first, "%d", c->first_timed_frame);
-    const char *fixed[] = {c->id, c->run.scene, c->run.solver, eps, scale, threads, frames, first};
-    int bad = 0;
+    char text[4096];
+    int bad = 0, first = 1;
     out[0] = '\0';
-    for (int i = 0; i < 8; ++i) bad |= put(out, cap, &len, fixed[i], i == 0);
-    if (m->uses_error_ref) bad |= put(out, cap, &len, c->run.error_ref ? c->run.error_ref : "", 0);
-    for (int a = 0; a < m->n_named; ++a) bad |= put(out, cap, &len, m->named[a].values[c->value[a]].label, 0);
-    if (m->repeat > 1) {
-        char rep[16];
-        snprintf(rep, sizeof rep, "%d", c->repeat);
-        bad |= put(out, cap, &len, rep, 0);
+    for (int k = 0; k < MATRIX_COLS; ++k) {
+        if (!matrix_results_has(m, (MatrixColumn)k)) continue;
+        if (k != MATRIX_COL_NAMED_AXES) {
+            matrix_results_field(c, x, (MatrixColumn)k, text, sizeof text);
+            bad |= put(out, cap, &len, text, first);
+        }
+        for (int a = 0; k == MATRIX_COL_NAMED_AXES && a < m->n_named; ++a)
+            bad |= put(out, cap, &len, m->named[a].values[c->value[a]].label, 0);
+        first = 0;
     }
-    if (m->has_references) {
-        bad |= put(out, cap, &len, c->is_reference ? "reference" : "cell", 0);
-        bad |= put(out, cap, &len, c->ref_id, 0);
-    }
-    kv_join(c->set, c->n_set, text, sizeof text);
-    bad |= put(out, cap, &len, text, 0);
-    kv_join(c->solver_opts, c->n_solver_opts, text, sizeof text);
-    bad |= put(out, cap, &len, text, 0);
     /* the measurement fields need no quoting: numbers and status names */
     bad |= cell_measure_format(o, x, text, sizeof text) || len + strlen(text) + 2 >= cap;
     if (!bad) snprintf(out + len, cap - len, ",%s", text);

@@ -1,24 +1,16 @@
 /* DIR/cells.csv, the table of a matrix's finished cells: one row per cell,
  * appended only after the cell finished, in one write() followed by fsync,
  * so a run killed at any moment leaves whole rows (a row cut short by a
- * crash mid-write is dropped when the file is opened again). The header:
- *
- *   id, scene, solver, eps, scale, threads (0 = OpenMP's default),
- *   frames_asked (0 = the scene's), first_timed_frame, error_ref (only when
- *   the matrix sets one), one column per named axis (its label), role (cell
- *   | reference) and reference (the reference cell's id; both only when the
- *   matrix has reference runs), set and solver_opts (the merged "k=v;k=v"
- *   text), then
- *   cell_measure_columns (experiments/matrix/matrix_measure.h): status, exit,
- *   frames, steps, outer_iters, linear_iters, inner_iters, wall_s,
- *   timed_frames, timed_wall_s, s_per_frame, max_frame_s, max_residual,
- *   converged_fraction, worst_solve_status, particles, peak_rss_mb,
- *   startup_s, elapsed_s. */
+ * crash mid-write is dropped when the file is opened again). Its columns:
+ * the cell's (the table of experiments/matrix/matrix_columns.c), then its
+ * measurements (cell_measure_columns, experiments/matrix/matrix_measure.h);
+ * docs/outputs.md says what each holds. */
 #ifndef MPM_MATRIX_RESULTS_H
 #define MPM_MATRIX_RESULTS_H
 
 #include "experiments/matrix/matrix_cells.h"
 #include "experiments/io/csv_table.h"
+#include "experiments/matrix/matrix_columns.h"
 #include "experiments/matrix/matrix_measure.h"
 
 typedef struct {
@@ -29,7 +21,12 @@ typedef struct {
     int n_ids;
 } CellsFile;
 
+/* Does the matrix's cells.csv have column k (matrix_columns.h)? */
+int matrix_results_has(const Matrix *m, MatrixColumn k);
 int matrix_results_header(const Matrix *m, char *out, size_t cap);
+/* The text of column k (not MATRIX_COL_NAMED_AXES) in cell c's row; x: the
+ * cell's measurements, NULL when it has none (the counts are then the asked ones). */
+void matrix_results_field(const MatrixCell *c, const CellMeasure *x, MatrixColumn k, char *out, size_t cap);
 int matrix_results_row(const Matrix *m, const MatrixCell *c, const CellOutcome *o, const CellMeasure *x, char *out,
                        size_t cap);
 

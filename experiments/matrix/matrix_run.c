@@ -286,21 +286,17 @@ static int build_tasks(Run *r, MatrixTask **out)
     return MPM_OK;
 }
 
-/* A column new to cells.csv (a named axis, error_ref, role, reference): the
- * value of the cell with that id. */
+/* A column new to cells.csv (a named axis, error_ref, repeat, role,
+ * reference): the value of the cell with that id. */
 static int fill_column(void *ctx, const char *id, const char *column, char *out, size_t cap)
 {
     const Run *r = ctx;
-    int a = matrix_named_index(&r->m, column);
-    for (int i = 0; i < r->cells.n; ++i) {
+    int a = matrix_named_index(&r->m, column), k = matrix_column_find(column);
+    for (int i = 0; i < r->cells.n && (a >= 0 || k >= 0); ++i) {
         const MatrixCell *c = &r->cells.cells[i];
         if (strcmp(c->id, id)) continue;
         if (a >= 0) snprintf(out, cap, "%s", r->m.named[a].values[c->value[a]].label);
-        else if (!strcmp(column, "error_ref")) snprintf(out, cap, "%s", c->run.error_ref ? c->run.error_ref : "");
-        else if (!strcmp(column, "role")) snprintf(out, cap, "%s", c->is_reference ? "reference" : "cell");
-        else if (!strcmp(column, "reference")) snprintf(out, cap, "%s", c->ref_id);
-        else if (!strcmp(column, "repeat")) snprintf(out, cap, "%d", c->repeat);
-        else return 0;
+        else matrix_results_field(c, NULL, (MatrixColumn)k, out, cap);
         return 1;
     }
     return 0;

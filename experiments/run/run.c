@@ -28,7 +28,7 @@
 void run_config_default(RunConfig *c)
 {
     memset(c, 0, sizeof *c);
-    c->eps = 1e-7;
+    c->eps = SOLVE_EPS_DEFAULT;
     c->scale = 1.0;
 }
 
@@ -76,14 +76,16 @@ int run_config_check(const RunConfig *cfg)
     if (!cfg->solver) return mpm_error(MPM_EINPUT, "run: --solver is required");
     if (!(cfg->scale > 0.0) || !isfinite(cfg->scale))
         return mpm_error(MPM_EINPUT, "--scale %g: expected a positive number", cfg->scale);
-    if (cfg->max_outer < 0) return mpm_error(MPM_EINPUT, "--max-outer %d: expected >= 1", cfg->max_outer);
-    if (cfg->max_linear < 0) return mpm_error(MPM_EINPUT, "--max-linear %d: expected >= 1", cfg->max_linear);
     if ((st = check_seconds("--max-step-seconds", cfg->max_step_s))) return st;
     if ((st = check_seconds("--max-run-seconds", cfg->max_run_s))) return st;
     if (cfg->on_failure != FAILURE_STOP && cfg->on_failure != FAILURE_CONTINUE)
         return mpm_error(MPM_EINPUT, "on_failure %d: expected stop or continue", (int)cfg->on_failure);
     SolveSettings set;
     run_solve_settings(cfg, &set);
+    /* the ranges of eps and the iteration limits are the solver's to check
+     * (0 asks for its default, which run_solve_settings keeps) */
+    if (cfg->max_outer) set.max_outer = cfg->max_outer;
+    if (cfg->max_linear) set.max_linear = cfg->max_linear;
     if ((st = solve_settings_check(&set))) return st;
     if ((st = paths_check_output_dir("--out", cfg->out_dir))) return st;
     if ((st = paths_check_output_dir("--particles", cfg->particles_dir))) return st;

@@ -21,7 +21,7 @@ typedef struct {
     const char *scene;          /* built-in name or JSON path */
     const char *solver;         /* solver spec: preset name or OUTER:INVERSE[:k=v,...] */
     int frames;                 /* <= 0: the scene's */
-    double eps;                 /* CN tolerance */
+    double eps;                 /* CN tolerance (default SOLVE_EPS_DEFAULT, solvers/solver.h) */
     double scale;               /* dx multiplier */
     int threads;                /* <= 0: OpenMP default */
     const char *out_dir;        /* NULL: out/<scene>-<solver> */
@@ -36,7 +36,7 @@ typedef struct {
     const char *asset_dir;
     int armijo;                 /* the same as solver option linesearch=armijo */
     int quiet;                  /* no per-frame table */
-    /* bounds on the work (0 = the default: 10000 iterations, no time limit) */
+    /* bounds on the work (0 = the default: solve_settings_default's iterations, no time limit) */
     int max_outer;              /* outer iterations per step */
     int max_linear;             /* PCG iterations per linear solve */
     double max_step_s;          /* a step's solve past this ends as timeout; the run goes on */

@@ -81,8 +81,8 @@ expect_input_error "run: unexpected argument 'drop'" run drop --solver pn-pcg
 expect_input_error "--view 'up': expected front, side, top or iso" render --scene drop --view=up
 expect_input_error "--jobs '0': expected an integer in \\[1, 1024\\]" matrix run "$src/experiments/matrices/smoke.json" --jobs=0
 expect_input_error "list 'solver': expected 'solvers', 'scenes' or 'definitions'" list solver
-expect_input_error "bench: expected spmv, assemble, tangent, hessvec, energy, gradient, p2g, g2p or all" bench --scene drop
-expect_input_error "--transfer 'pic': expected apic or mls" bench p2g --scene drop --transfer=pic
+expect_input_error "bench: expected spmv, hessvec, assemble, tangent, energy, gradient, p2g, g2p or all" bench --scene drop
+expect_input_error "--transfer 'pic': expected apic, mls or pic_flip" bench p2g --scene drop --transfer=pic
 
 # exit 3: matrix run --check with a failed cell (killed at its wall-clock limit)
 cat >"$tmp/check.json" <<'EOF'

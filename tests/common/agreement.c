@@ -13,10 +13,7 @@
 #include "tests/common/scene_fixture.h"
 #include "tests/common/testutil.h"
 
-static const char *transfer_name(const AgreementCase *c)
-{
-    return c->transfer == TRANSFER_MLS ? "mls" : c->transfer == TRANSFER_PIC_FLIP ? "pic_flip" : "apic";
-}
+static const char *transfer_name(const AgreementCase *c) { return transfer_kind_name(c->transfer); }
 
 typedef struct {
     double last;

@@ -97,7 +97,7 @@ bad reference-opt 'reference-opt\.json: solver "pn-pcg" \(reference\.solver\) wi
   '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hot"]}, "reference": {"solver": "pn-pcg", "solver_opts": {"window": 4}}}'
 expect_input_error '--jobs .0.: expected an integer' matrix run "$tmp/unknown-top.json" --jobs 0
 expect_input_error 'no-such\.json: cannot read matrix file' matrix run "$tmp/no-such.json"
-expect_input_error "matrix 'go': expected 'run' or 'report'" matrix go
+expect_input_error "matrix 'go': expected 'run', 'report' or 'schema'" matrix go
 
 # --dry-run: the cells with ids, nothing written
 mk ok "{$head, \"axes\": {\"scene\": [\"stretched-box\", \"drop\"], \"solver\": [\"hot\", \"pn-pcg\"],

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # needs: MPM_WITH_CHOLMOD
-# docs/matrix.schema.json describes the matrix-file format the loader
-# accepts: every committed experiments/matrices/*.json validates against it,
+# docs/matrix.schema.json (generated: test_matrix_schema_generated.sh)
+# describes the matrix-file format the loader accepts: every committed
+# experiments/matrices/*.json validates against it,
 # and on a set of probe files (every key at every level, unknown keys, wrong
 # types) the schema and `mpmbench matrix run --dry-run` agree on valid /
 # invalid. Needs python3-jsonschema (installed by scripts/test.sh).
@@ -75,4 +76,12 @@ probe repeat-zero invalid "{\"name\": \"t\", $ax, \"repeat\": 0}"
 probe repeat-real invalid "{\"name\": \"t\", $ax, \"repeat\": 2.5}"
 probe repeat-huge invalid "{\"name\": \"t\", $ax, \"repeat\": 101}"
 probe report-unknown invalid "{\"name\": \"t\", $ax, \"report\": {\"figures\": true}}"
+# the generated schema knows what the tables know: a table's range, the results tables' columns, the axes
+probe threads-huge invalid "{\"name\": \"t\", $ax, \"defaults\": {\"threads\": 2000}}"
+probe axis-measure-column invalid '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hot"], "sets": {"steps": [{"frames": 2}]}}}'
+probe axis-check-column invalid '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hot"], "sets": {"pass": [{"frames": 2}]}}}'
+probe rule-bad-key invalid "{\"name\": \"t\", $ax, \"include\": [{\"Solver\": \"hot\"}]}"
+probe rule-named-axis valid '{"name": "t", "axes": {"scene": ["drop"], "solver": ["hot"], "sets": {"stiff": [{"materials.soft.E": 1e5}]}},
+  "include": [{"stiff": "1e+05", "eps": 1e-7}]}'
+probe reference-eps-zero invalid "{\"name\": \"t\", $ax, \"reference\": {\"solver\": \"hot\", \"eps\": 0}}"
 finish

@@ -170,7 +170,7 @@ static void config_check(void)
     mpm_clear_error();
     CHECK(run_config_check(&c) == MPM_EINPUT && strstr(mpm_last_error(), "--eps"), "eps below the floor refused: %s",
           mpm_last_error());
-    c.eps = 1e-7;
+    c.eps = SOLVE_EPS_DEFAULT;
     c.solver_opts[0] = "window=2.5";
     c.n_solver_opts = 1;
     mpm_clear_error();

@@ -3,7 +3,8 @@
  * one command-line parser (experiments/cli/cli.c), driven by the tables
  * themselves so that a new table line is tested without a new test:
  *  - the table is well formed: flags and keys unique, no two lines set the
- *    same RunConfig field, every matrix key has an id rule;
+ *    same RunConfig field, every matrix key has an id rule, every axis a
+ *    cells.csv column, no key is also one of the matrix file's own;
  *  - `--flag value` and `--flag=value` give the same RunConfig, which differs
  *    from the default in that setting only;
  *  - run_config_argv reads back: a RunConfig with every setting away from
@@ -24,6 +25,8 @@
 #include "experiments/commands/commands.h"
 #include "experiments/cli/run_settings.h"
 #include "experiments/matrix/matrix_cells.h"
+#include "experiments/matrix/matrix_columns.h"
+#include "experiments/matrix/matrix_keys.h"
 #include "tests/common/testutil.h"
 
 static char g_dir[256];
@@ -92,7 +95,9 @@ static void table_well_formed(void)
     for (int k = 0; k < run_settings_count; ++k) {
         const Option *o = &run_settings[k];
         CHECK(o->flag && !strncmp(o->flag, "--", 2) && o->help && o->help[0], "line %d: flag and help", k);
-        CHECK((o->type == OPT_SWITCH) == (o->metavar == NULL), "%s: a value name unless a switch", o->flag);
+        char value[64];
+        option_metavar(o, value, sizeof value);
+        CHECK((o->type == OPT_SWITCH) == (value[0] == '\0'), "%s: a value name unless a switch", o->flag);
         CHECK(o->type != OPT_CHOICE || (o->choices && o->choices[0]), "%s: choices", o->flag);
         CHECK(o->type != OPT_LIST || o->count_offset != 0, "%s: a list needs its count", o->flag);
         for (int j = 0; j < k; ++j) {
@@ -109,6 +114,11 @@ static void table_well_formed(void)
         for (const char *c = o->key; *c; ++c) CHECK((*c >= 'a' && *c <= 'z') || *c == '_', "key %s", o->key);
         CHECK(o->flags & OPT_IN_DEFAULTS, "%s: a key allowed in defaults", o->key);
         CHECK(!((o->flags & OPT_ID_ALWAYS) && (o->flags & OPT_ID_GIVEN)), "%s: one id rule", o->key);
+        /* the report tells cases apart by cells.csv's columns; a rule names an axis by its column */
+        CHECK(!(o->flags & OPT_AXIS) || matrix_column_find(o->key) >= 0, "axis %s: a cells.csv column of that name",
+              o->key);
+        CHECK(!matrix_key(MATRIX_AT_SETTINGS, o->key) && (!(o->flags & OPT_AXIS) || !matrix_key(MATRIX_AT_AXES, o->key)),
+              "%s: a run setting and, where it stands, a matrix file key of its own", o->key);
         if (!(o->flags & (OPT_ID_ALWAYS | OPT_ID_GIVEN))) ++keyed_without_id;
         CHECK((o->flags & (OPT_ID_ALWAYS | OPT_ID_GIVEN)) || (o->flags & OPT_KEY_DIR),
               "%s: a key outside the cell id must only locate files", o->key);
@@ -373,7 +383,7 @@ static int parse_cmd(const Command *cmd, int argc, const char *const *args, void
 {
     char *all[8];
     int n = 0;
-    if (cmd->operand) all[n++] = (char *)(cmd->operand_choices ? cmd->operand_choices[0] : "operand");
+    if (cli_takes_operand(cmd)) all[n++] = (char *)(cmd->operand_choices ? cmd->operand_choices[0] : "operand");
     for (int i = 0; i < argc; ++i) all[n++] = (char *)args[i];
     const char *got;
     int help;
