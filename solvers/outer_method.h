@@ -30,7 +30,7 @@
  * status capped, stalls at an unreachable tolerance; when it claims
  * OUTER_DESCENT: never accepts an energy increase).
  *
- * Statistics contract (SolveStats, README "Solvers"):
+ * Statistics contract (SolveStats, docs/solvers.md "Statistics contract"):
  *  - outer_iters: iterations of the outer method;
  *  - linear_iters: PCG iterations of the outer method's own linear solves
  *    (PN's H p = -g; 0 for L-BFGS, which solves none);

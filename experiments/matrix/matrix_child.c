@@ -13,19 +13,13 @@
 #include <unistd.h>
 
 #include "core/error.h"
+#include "core/event_log.h"
 #include "experiments/matrix/machine_load.h"
 
 extern char **environ;
 
 /* wait4 is BSD/GNU; declared here so the file builds with _POSIX_C_SOURCE. */
 pid_t wait4(pid_t pid, int *status, int options, struct rusage *rusage);
-
-double matrix_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 void matrix_sleep_ms(int ms)
 {
@@ -101,7 +95,7 @@ int cell_child_start(char *const *args, int argc, const char *dir, double timeou
     if (pid > 0) {
         setpgid(pid, pid); /* also here: no race with a kill of the group */
         c->pid = pid;
-        c->t_start = matrix_now();
+        c->t_start = event_clock();
         c->timeout_s = timeout_s;
         c->busy0 = busy0;
         c->load0 = load0;
@@ -114,10 +108,19 @@ int cell_child_start(char *const *args, int argc, const char *dir, double timeou
     return st;
 }
 
+void cell_child_kill(CellChild *c)
+{
+    if (!c->pid) return;
+    kill(-c->pid, SIGKILL);
+    while (waitpid(c->pid, NULL, 0) < 0 && errno == EINTR) {
+    }
+    c->pid = 0;
+}
+
 int cell_child_poll(CellChild *c, CellOutcome *out)
 {
     if (!c->pid) return 0;
-    double now = matrix_now();
+    double now = event_clock();
     if (!c->timed_out && c->timeout_s > 0 && now - c->t_start > c->timeout_s) {
         kill(-c->pid, SIGKILL);
         c->timed_out = 1;

@@ -35,8 +35,10 @@ int cell_child_start(char *const *args, int argc, const char *dir, double timeou
  * it kills the child's process group first. */
 int cell_child_poll(CellChild *c, CellOutcome *out);
 
-/* Monotonic clock in seconds. */
-double matrix_now(void);
+/* Kills a running child's process group and reaps it (a study that ends on
+ * an error leaves no cell behind); nothing when none runs. */
+void cell_child_kill(CellChild *c);
+
 /* Sleeps for `ms` milliseconds (the runners' polling interval). */
 void matrix_sleep_ms(int ms);
 

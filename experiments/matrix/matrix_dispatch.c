@@ -12,7 +12,18 @@
 #include "experiments/matrix/matrix_results.h"
 #include "experiments/io/paths.h"
 
-enum { TAG_REQUEST = 1, TAG_TASK = 2, TAG_STOP = 3, TAG_RESULT = 4 };
+/* The protocol. A worker asks (REQUEST) when it has a free slot and gets a
+ * TASK, or STOP once nothing is left: it then finishes its cells, sending
+ * each RESULT, says BYE and waits for rank 0's FIN. A worker that fails
+ * sends FAILED with its message instead of going on. Rank 0 on any error
+ * (its own or a FAILED) sends ABORT to every rank it has no BYE from: they
+ * kill their cells, say BYE and wait for FIN. Rank 0 answers every BYE with
+ * a FIN once it has them all, so every message sent is received, and every
+ * rank leaves the dispatch on every path: one rank's error ends the study
+ * everywhere, without MPI_Abort. */
+enum { TAG_REQUEST = 1, TAG_TASK = 2, TAG_STOP = 3, TAG_RESULT = 4, TAG_FAILED = 5, TAG_ABORT = 6, TAG_BYE = 7,
+       TAG_FIN = 8 };
+enum { FAILED_TEXT = 512 };
 enum { POLL_MS = 5, MAX_ARGS = 512 };
 
 /* ---------------------------------------------------------------- local slots */
@@ -91,6 +102,15 @@ static int count_busy(const Slot *s, int n)
     int b = 0;
     for (int i = 0; i < n; ++i) b += s[i].busy;
     return b;
+}
+
+static void kill_all(Slot *s, int n)
+{
+    for (int i = 0; i < n; ++i)
+        if (s[i].busy) {
+            cell_child_kill(&s[i].child);
+            s[i].busy = 0;
+        }
 }
 
 static Slot *free_slot(Slot *s, int n)
@@ -204,24 +224,48 @@ static void board_done(Board *b, const MatrixResult *r)
         }
 }
 
+/* A failure to inject on one rank, for the test of the error paths
+ * (tests/matrix/test_matrix_mpi.sh): MPM_TEST_FAIL_RANK=R makes rank R fail
+ * when it is handed its first cell. */
+static int injected_failure(int rank)
+{
+    const char *v = getenv("MPM_TEST_FAIL_RANK");
+    if (!v || !*v || atoi(v) != rank) return MPM_OK;
+    return mpm_error(MPM_EINTERNAL, "injected failure (MPM_TEST_FAIL_RANK=%d)", rank);
+}
+
 static int serve(const MatrixTask *tasks, int n, int jobs, int use_mpi, const MatrixDispatchHooks *h)
 {
     int ranks = 1;
     if (use_mpi) MPI_Comm_size(MPI_COMM_WORLD, &ranks);
     Slot *slots = calloc((size_t)jobs, sizeof *slots);
     Board b = {tasks, n, calloc((size_t)n + 1, 1), 0, n, h};
-    int *waiting = calloc((size_t)ranks, sizeof *waiting); /* ranks asking while no task was ready */
-    if (!slots || !b.state || !waiting) {
+    int *waiting = calloc((size_t)ranks, sizeof *waiting);      /* ranks asking while no task was ready */
+    unsigned char *said_bye = calloc((size_t)ranks, 1), *aborted = calloc((size_t)ranks, 1);
+    char *failed = malloc(FAILED_TEXT);
+    if (!slots || !b.state || !waiting || !said_bye || !aborted || !failed) {
         free(slots);
         free(b.state);
         free(waiting);
+        free(said_bye);
+        free(aborted);
+        free(failed);
         return mpm_error(MPM_EINTERNAL, "out of memory");
     }
     Outbox out = {.n = 0};
-    int n_waiting = 0, stopped = 0, remote_running = 0, st = MPM_OK;
-    while (!st && (b.finished < n || stopped < ranks - 1)) {
+    int n_waiting = 0, byes = 0, remote_running = 0, st = injected_failure(0);
+    if (st) st = mpm_error_context(st, "rank 0");
+    /* until every task is finished (or the study failed) and every worker has said bye */
+    while ((!st && b.finished < n) || byes < ranks - 1) {
         int busy_round = 0;
         MatrixResult r;
+        if (st) {
+            /* the study failed: no new cell, none left running, every worker told */
+            kill_all(slots, jobs);
+            for (int k = 1; k < ranks; ++k)
+                if (!said_bye[k] && !aborted[k] && !outbox_send(&out, NULL, 0, k, TAG_ABORT)) aborted[k] = 1;
+            n_waiting = 0;
+        }
         for (int i = 0; i < jobs && !st; ++i)
             if (slot_poll(&slots[i], 0, &r)) {
                 board_done(&b, &r);
@@ -235,22 +279,36 @@ static int serve(const MatrixTask *tasks, int n, int jobs, int use_mpi, const Ma
             st = slot_start(s, &tasks[next]);
             busy_round = 1;
         }
-        while (!st && use_mpi) {
+        while (use_mpi) {
             int flag = 0;
             MPI_Status ms;
             MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &ms);
             if (!flag) break;
             busy_round = 1;
+            int from = ms.MPI_SOURCE;
             if (ms.MPI_TAG == TAG_REQUEST) {
-                MPI_Recv(NULL, 0, MPI_BYTE, ms.MPI_SOURCE, TAG_REQUEST, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-                waiting[n_waiting++] = ms.MPI_SOURCE; /* answered below */
+                MPI_Recv(NULL, 0, MPI_BYTE, from, TAG_REQUEST, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                if (!st) waiting[n_waiting++] = from; /* answered below */
             } else if (ms.MPI_TAG == TAG_RESULT) {
-                MPI_Recv(&r, (int)sizeof r, MPI_BYTE, ms.MPI_SOURCE, TAG_RESULT, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                MPI_Recv(&r, (int)sizeof r, MPI_BYTE, from, TAG_RESULT, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
                 remote_running--;
                 board_done(&b, &r);
-                st = h->done(h->ctx, &r);
+                if (!st) st = h->done(h->ctx, &r); /* after a failure too the cell is recorded, if it can be */
+                else h->done(h->ctx, &r);
+            } else if (ms.MPI_TAG == TAG_FAILED) {
+                MPI_Recv(failed, FAILED_TEXT, MPI_CHAR, from, TAG_FAILED, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                failed[FAILED_TEXT - 1] = '\0';
+                if (!st) st = mpm_error(MPM_EINTERNAL, "%s", failed);
+            } else if (ms.MPI_TAG == TAG_BYE) {
+                MPI_Recv(NULL, 0, MPI_BYTE, from, TAG_BYE, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                said_bye[from] = 1;
+                byes++;
             } else {
-                st = mpm_error(MPM_EINTERNAL, "unexpected MPI message (tag %d) from rank %d", ms.MPI_TAG, ms.MPI_SOURCE);
+                int bytes = 0;
+                MPI_Get_count(&ms, MPI_BYTE, &bytes);
+                MPI_Recv(failed, bytes < FAILED_TEXT ? bytes : FAILED_TEXT, MPI_BYTE, from, ms.MPI_TAG,
+                         MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                if (!st) st = mpm_error(MPM_EINTERNAL, "unexpected MPI message (tag %d) from rank %d", ms.MPI_TAG, from);
             }
         }
         /* the waiting ranks: a ready task each, or stop once nothing is left to hand out */
@@ -263,7 +321,6 @@ static int serve(const MatrixTask *tasks, int n, int jobs, int use_mpi, const Ma
                 remote_running++;
             } else if (b.pending == 0) {
                 st = outbox_send(&out, NULL, 0, dest, TAG_STOP);
-                stopped++;
             } else {
                 break; /* every remaining task waits for a running one */
             }
@@ -274,10 +331,15 @@ static int serve(const MatrixTask *tasks, int n, int jobs, int use_mpi, const Ma
         if (h->tick) h->tick(h->ctx, count_busy(slots, jobs) + remote_running);
         if (!busy_round) matrix_sleep_ms(POLL_MS);
     }
-    if (use_mpi && !st) outbox_flush(&out);
+    kill_all(slots, jobs);
+    for (int k = 1; k < ranks; ++k) outbox_send(&out, NULL, 0, k, TAG_FIN);
+    if (use_mpi) outbox_flush(&out);
     free(slots);
     free(b.state);
     free(waiting);
+    free(said_bye);
+    free(aborted);
+    free(failed);
     return st;
 }
 
@@ -295,8 +357,8 @@ static int work(int jobs)
         return mpm_error(MPM_EINTERNAL, "out of memory");
     }
     Outbox out = {.n = 0};
-    int asked = 0, stop = 0, st = MPM_OK;
-    while (!st && (!stop || count_busy(slots, jobs))) {
+    int asked = 0, stop = 0, aborted = 0, st = MPM_OK, first = 1;
+    while (!st && !aborted && (!stop || count_busy(slots, jobs))) {
         int busy_round = 0;
         MatrixResult r;
         for (int i = 0; i < jobs && !st; ++i)
@@ -308,29 +370,52 @@ static int work(int jobs)
             st = outbox_send(&out, NULL, 0, 0, TAG_REQUEST);
             asked = 1;
         }
-        if (!st && asked) {
-            int flag = 0;
-            MPI_Status ms;
-            MPI_Iprobe(0, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &ms);
-            if (flag) {
-                busy_round = 1;
+        int flag = 0;
+        MPI_Status ms;
+        if (!st) MPI_Iprobe(0, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &ms);
+        if (flag) {
+            busy_round = 1;
+            if (ms.MPI_TAG == TAG_TASK) {
                 asked = 0;
-                if (ms.MPI_TAG == TAG_TASK) {
-                    MPI_Recv(task, (int)sizeof *task, MPI_BYTE, 0, TAG_TASK, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-                    st = slot_start(free_slot(slots, jobs), task);
-                } else {
-                    MPI_Recv(NULL, 0, MPI_BYTE, 0, ms.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-                    stop = 1;
-                }
+                MPI_Recv(task, (int)sizeof *task, MPI_BYTE, 0, TAG_TASK, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                if (first) st = injected_failure(rank);
+                first = 0;
+                if (!st) st = slot_start(free_slot(slots, jobs), task);
+            } else {
+                MPI_Recv(NULL, 0, MPI_BYTE, 0, ms.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                if (ms.MPI_TAG == TAG_ABORT) aborted = 1;
+                else stop = 1; /* TAG_STOP */
+                asked = 0;
             }
         }
         outbox_progress(&out);
         if (!busy_round) matrix_sleep_ms(POLL_MS);
     }
-    if (!st) outbox_flush(&out);
+    if (st) { /* rank 0 reports it and ends the study everywhere */
+        char text[FAILED_TEXT];
+        snprintf(text, sizeof text, "rank %d: %s", rank, mpm_last_error());
+        outbox_send(&out, text, (int)strlen(text) + 1, 0, TAG_FAILED);
+        mpm_clear_error();
+    }
+    kill_all(slots, jobs);
+    outbox_send(&out, NULL, 0, 0, TAG_BYE);
+    /* until rank 0's FIN: whatever else it sent meanwhile (a task, an abort) is received and dropped */
+    for (int fin = 0; !fin;) {
+        int flag = 0;
+        MPI_Status ms;
+        MPI_Iprobe(0, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &ms);
+        if (!flag) {
+            outbox_progress(&out);
+            matrix_sleep_ms(POLL_MS);
+            continue;
+        }
+        MPI_Recv(task, (int)sizeof *task, MPI_BYTE, 0, ms.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+        fin = ms.MPI_TAG == TAG_FIN;
+    }
+    outbox_flush(&out);
     free(slots);
     free(task);
-    return st;
+    return MPM_OK;
 }
 
 int matrix_dispatch(const MatrixTask *tasks, int n, int jobs, int use_mpi, const MatrixDispatchHooks *hooks)

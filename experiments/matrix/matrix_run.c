@@ -8,6 +8,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "core/event_log.h"
 #include "core/error.h"
 #include "experiments/matrix/matrix_cells.h"
 #include "experiments/matrix/matrix_check.h"
@@ -125,7 +126,7 @@ static void clear_tick(Run *r)
 static void tick(void *ctx, int running)
 {
     Run *r = ctx;
-    double now = matrix_now();
+    double now = event_clock();
     if (!r->terminal || now - r->last_tick < 0.5) return;
     r->last_tick = now;
     double el = now - r->t_start;
@@ -402,37 +403,32 @@ int matrix_run(const char *file, const MatrixRunOptions *o, int *failed)
     memset(&r, 0, sizeof r);
     r.results.fd = -1;
     int go = 0, st = MPM_OK;
+    MatrixTask *tasks = NULL;
     if (rank == 0) st = prepare(&r, file, o, use_mpi, ranks, &go);
+    if (go && rank == 0) {
+        /* before the other ranks hear go: an error here must stop them too */
+        if ((st = build_tasks(&r, &tasks))) go = 0;
+        const char *ci = getenv("CI");
+        r.terminal = isatty(STDERR_FILENO) && !(ci && *ci);
+        r.t_start = event_clock();
+    }
     if (use_mpi) {
         MPI_Request req;
         MPI_Ibcast(&go, 1, MPI_INT, 0, MPI_COMM_WORLD, &req);
         mpi_wait_sleeping(&req);
     }
-    MatrixTask *tasks = NULL;
-    if (go && rank == 0) {
-        st = build_tasks(&r, &tasks);
-        const char *ci = getenv("CI");
-        r.terminal = isatty(STDERR_FILENO) && !(ci && *ci);
-        r.t_start = matrix_now();
-    }
-    if (go && st && use_mpi) {
-        fprintf(stderr, "mpmbench: error: %s\n", mpm_last_error());
-        MPI_Abort(MPI_COMM_WORLD, 1);
-    }
     if (go) {
+        /* every rank leaves the dispatch on every path (matrix_dispatch.c's
+         * protocol); rank 0 returns the study's error, whichever rank had it */
         MatrixDispatchHooks hooks = {cell_done, tick, skipped, &r};
         st = matrix_dispatch(tasks, rank == 0 ? r.n_todo : 0, o->jobs, use_mpi, &hooks);
-        if (st && use_mpi) { /* the other ranks would wait for ever */
-            fprintf(stderr, "mpmbench: error (rank %d): %s\n", rank, mpm_last_error());
-            MPI_Abort(MPI_COMM_WORLD, 1);
-        }
         if (rank == 0) {
             clear_tick(&r);
             printf("matrix %s: %d cells ran (%d ok, %d bad-input, %d failed, %d crashed, %d timeout, %d time-limit) in "
                    "%.3f s; %s/cells.csv\n",
                    r.m.name, r.n_finished, r.n_status[CELL_OK], r.n_status[CELL_BAD_INPUT], r.n_status[CELL_FAILED],
                    r.n_status[CELL_CRASHED], r.n_status[CELL_TIMEOUT], r.n_status[CELL_TIME_LIMIT],
-                   matrix_now() - r.t_start, r.dir);
+                   event_clock() - r.t_start, r.dir);
             if (r.n_busy)
                 printf("matrix %s: %d cells ran while other processes used the machine (machine_busy = 1 in "
                        "cells.csv): their times are not valid\n", r.m.name, r.n_busy);

@@ -17,7 +17,7 @@
  * (solvers/krylov/minres.c), preconditioned by the inverse approximation (which
  * must be SPD; the preset uses Gast's rest-configuration diagonal).
  *
- * Statistics (README "Solvers"): outer_iters = 1, linear_iters = MINRES
+ * Statistics (docs/solvers.md "Statistics contract"): outer_iters = 1, linear_iters = MINRES
  * iterations; the residual is the CN residual of g at the returned dv (how
  * far the linearised step is from solving the nonlinear one; it is not
  * driven below eps); status converged = MINRES reached its relative

@@ -5,7 +5,11 @@
 # equal a serial run's, row for row in everything but times. One cell uses
 # BoomerAMG, whose adapter calls MPI_Init in the child: the child must start
 # as an MPI singleton of its own (the launcher's variables scrubbed), not
-# join the runner's job. Skipped (exit 77) when mpirun is missing.
+# join the runner's job. An error on one rank only (injected with
+# MPM_TEST_FAIL_RANK: rank 1 when handed its first cell, or rank 0 at the
+# start) ends the study on every rank with exit 1 and one error line naming
+# the rank, without a hang or MPI_Abort, and no cell process left behind.
+# Skipped (exit 77) when mpirun is missing.
 . "$(dirname "$0")/../common/shell_harness.sh"
 
 command -v mpirun >/dev/null || skip "mpirun not found (Debian package openmpi-bin)"
@@ -47,4 +51,16 @@ check "report of the distributed run exit 0" test $? -eq 0
 check "its report says it ran on 2 ranks" grep -q "mpirun: 2 ranks x 1 job)" "$tmp/mpi/report.md"
 "$bin" matrix report "$tmp/serial" >"$tmp/report-serial.txt" 2>&1
 check "the serial report says no mpirun" bash -c "! grep -q 'mpirun:' '$tmp/serial/report.md'"
+
+# an error on one rank only
+for fail in 1 0; do
+  MPM_TEST_FAIL_RANK=$fail mpirun_ranks -x MPM_TEST_FAIL_RANK -np 2 "$bin" matrix run "$tmp/m.json" --out "$tmp/fail$fail" \
+    >"$tmp/fail$fail.txt" 2>"$tmp/fail$fail.err"
+  rc=$?
+  check "rank $fail fails: exit 1, not a hang (124) or an abort (got $rc: $(head -c 300 "$tmp/fail$fail.err"))" test "$rc" -eq 1
+  check "rank $fail fails: one error line naming it ($(cat "$tmp/fail$fail.err"))" \
+    test "$(grep -c "^mpmbench: error: rank $fail: injected failure" "$tmp/fail$fail.err")" -eq 1
+  check "rank $fail fails: no MPI_Abort" bash -c "! grep -q 'MPI_ABORT was invoked' '$tmp/fail$fail.err'"
+done
+check "no cell process outlives the failed studies" bash -c "! pgrep -f -- '--out $tmp/fail[01]/cells' >/dev/null"
 finish
