@@ -76,6 +76,13 @@ const Option run_settings[] = {
      "replay that run's time steps (a reference run made with --trajectory)"},
     {"--trajectory-ref", NULL, "RUN_DIR", OPT_TEXT, 0, 0, "a run directory", NULL, F(trajectory_ref), 0, NULL, 0,
      "the trajectory error per frame against that run (frames.csv pos_rms, pos_max, vel_rms)"},
+    {"--checkpoint-at", NULL, "F,F,...", OPT_TEXT, 0, 0, "frame numbers", NULL, F(checkpoint_at), 0,
+     run_check_frame_list, 0,
+     "write the whole simulation state at the start of these frames (0 = the initial state) into "
+     "OUT/checkpoints/frame_NNNN.ckpt"},
+    {"--from", NULL, "FILE", OPT_TEXT, 0, 0, "a checkpoint file", NULL, F(from), 0, NULL, 0,
+     "continue from a checkpoint (--checkpoint-at) of the same scene, scale and --set: the steps from its frame on "
+     "are those of the run that wrote it, bit for bit; --frames is still the last frame"},
     {"--max-particles", NULL, "N", OPT_SIZE, 1, 1e12, "a whole number of particles", NULL, F(max_particles), 0, NULL,
      0, "refuse a scene above N particles (default: physical memory / 16 KiB)"},
     {"--quiet", NULL, NULL, OPT_SWITCH, 0, 0, NULL, NULL, F(quiet), 0, NULL, 0, "no per-frame table on stdout"},

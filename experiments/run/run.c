@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/step.h"
 #include "core/scene/scene_load.h"
+#include "experiments/io/checkpoint.h"
 #include "experiments/io/csv_write.h"
 #include "experiments/driver/library_startup.h"
 #include "experiments/io/paths.h"
@@ -57,6 +58,57 @@ void run_session_config(const RunConfig *cfg, SessionConfig *sc, const char **li
                           .solver_opts = list, .n_solver_opts = n, .threads = cfg->threads};
 }
 
+int run_check_frame_list(const char *text)
+{
+    int n = 0;
+    const char *c = text;
+    while (*c) {
+        char *end;
+        long f = strtol(c, &end, 10);
+        if (end == c || f < 0 || f > 100000000 || (*end && *end != ',') || ++n > RUN_MAX_LIST)
+            return mpm_error(MPM_EINPUT, "--checkpoint-at '%s': expected at most %d frame numbers >= 0 separated by commas",
+                             text, RUN_MAX_LIST);
+        c = *end ? end + 1 : end;
+        if (*end && !*c) return mpm_error(MPM_EINPUT, "--checkpoint-at '%s': a comma at the end", text);
+    }
+    if (!n) return mpm_error(MPM_EINPUT, "--checkpoint-at '': expected frame numbers");
+    return MPM_OK;
+}
+
+/* Is `frame` in the (checked) list, and the largest listed frame. */
+static int frame_listed(const char *list, int frame, int *largest)
+{
+    int found = 0;
+    *largest = -1;
+    for (const char *c = list; c && *c;) {
+        char *end;
+        long f = strtol(c, &end, 10);
+        found |= f == frame;
+        if (f > *largest) *largest = (int)f;
+        c = *end ? end + 1 : end;
+    }
+    return found;
+}
+
+/* What a checkpoint must have been written for: the scene file's bytes, the
+ * scale and every --set, in order (checkpoint.h). */
+static int scene_fingerprint(const RunConfig *cfg, const Scene *scene, uint64_t *fp)
+{
+    FILE *f = fopen(scene->path, "rb");
+    if (!f) return mpm_error(MPM_EINPUT, "%s: cannot read the scene file again", scene->path);
+    uint64_t h = CHECKPOINT_FNV_BASIS;
+    unsigned char buf[65536];
+    size_t got;
+    while ((got = fread(buf, 1, sizeof buf, f)) > 0) h = checkpoint_hash(h, buf, got);
+    fclose(f);
+    char scale[64];
+    snprintf(scale, sizeof scale, "scale=%.17g", cfg->scale);
+    h = checkpoint_hash(h, scale, strlen(scale) + 1);
+    for (int i = 0; i < cfg->n_set; ++i) h = checkpoint_hash(h, cfg->set[i], strlen(cfg->set[i]) + 1);
+    *fp = h;
+    return MPM_OK;
+}
+
 static AccuracyConfig accuracy_config(const RunConfig *cfg)
 {
     AccuracyConfig a = {cfg->error_ref, cfg->dt_from, cfg->trajectory_ref, cfg->trajectory};
@@ -93,6 +145,15 @@ int run_config_check(const RunConfig *cfg)
     if (cfg->vtk_grid && !cfg->vtk_dir) return mpm_error(MPM_EINPUT, "--vtk-grid: needs --vtk DIR");
     AccuracyConfig acc = accuracy_config(cfg);
     if ((st = run_accuracy_check(&acc))) return st;
+    if (cfg->checkpoint_at && (st = run_check_frame_list(cfg->checkpoint_at))) return st;
+    if (cfg->from) {
+        /* the replays and comparisons count frames from the start of the animation */
+        if (cfg->dt_from || cfg->trajectory_ref || cfg->trajectory)
+            return mpm_error(MPM_EINPUT, "--from: not with %s (they follow a run from frame 0)",
+                             cfg->dt_from ? "--dt-from" : cfg->trajectory_ref ? "--trajectory-ref" : "--trajectory");
+        int frame;
+        if ((st = checkpoint_frame(cfg->from, &frame))) return st;
+    }
     const char *opts[RUN_MAX_SOLVER_OPTS];
     int n = solver_option_list(cfg, opts);
     return solver_spec_check(cfg->solver, opts, n);
@@ -117,6 +178,8 @@ typedef struct {
     FILE *steps_csv, *frames_csv, *iters_csv;
     int threads;
     VtkSeries *vtk;            /* --vtk: the ParaView series, else NULL */
+    const char *out_dir;
+    uint64_t fingerprint;      /* the scene's, for checkpoints */
 } RunOutput;
 
 static void write_iteration(void *ctx, int frame, int step, int iter, double elapsed, double residual, double energy)
@@ -128,8 +191,15 @@ static void write_iteration(void *ctx, int frame, int step, int iter, double ela
 
 static int before_step(void *ctx, Simulation *sim, int frame, int step, StepWork *w)
 {
-    (void)frame;
     RunOutput *o = ctx;
+    int largest;
+    if (step == 0 && o->cfg->checkpoint_at && frame_listed(o->cfg->checkpoint_at, frame, &largest)) {
+        char path[1200];
+        snprintf(path, sizeof path, "%s/checkpoints", o->out_dir);
+        int st = paths_mkdir_p(path);
+        snprintf(path, sizeof path, "%s/checkpoints/frame_%04d.ckpt", o->out_dir, frame);
+        if (st || (st = checkpoint_write(path, sim, o->fingerprint))) return st;
+    }
     return run_accuracy_before_step(o->acc, sim, step, w);
 }
 
@@ -188,7 +258,8 @@ static int write_frame(void *ctx, const Simulation *sim, const FrameSums *fs, in
 /* Records the exact configuration beside the tables, so every number says
  * how it was made (jansson escapes every string). */
 static void write_run_json(const char *dir, const RunConfig *cfg, const Scene *sc, const Solver *solver,
-                           const SolveSettings *set, const RunAccuracy *acc, int frames, int threads, int *status)
+                           const SolveSettings *set, const RunAccuracy *acc, int frames, int first_frame, int threads,
+                           int *status)
 {
     AccuracyConfig ac = accuracy_config(cfg);
     const SolverOptions *so = &solver->opts;
@@ -220,6 +291,11 @@ static void write_run_json(const char *dir, const RunConfig *cfg, const Scene *s
         *status = MPM_EINTERNAL;
     }
     if (root) json_object_set_new(root, "accuracy", (json_t *)run_accuracy_json(&ac, acc));
+    if (root) /* where the run started and where it leaves checkpoints */
+        json_object_set_new(root, "checkpoints",
+                            json_pack("{s:o, s:i, s:o}", "from", cfg->from ? json_string(cfg->from) : json_null(),
+                                      "first_frame", first_frame, "at",
+                                      cfg->checkpoint_at ? json_string(cfg->checkpoint_at) : json_null()));
     if (root) json_object_set_new(root, "startup_s", json_real(library_startup_seconds()));
     /* threads each phase ran on: the inverse approximation's library may
      * not use the run's OpenMP team (hypre: 1 in Debian's build) */
@@ -267,7 +343,26 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     }
     int frames = cfg->frames > 0 ? cfg->frames : scene->frames;
     /* the reference runs match this scene: checked before the output folder is made */
-    if ((status = run_accuracy_bind(&acfg, scene, frames, &acc))) {
+    uint64_t fingerprint = 0;
+    int largest = -1;
+    if (cfg->checkpoint_at) frame_listed(cfg->checkpoint_at, -1, &largest);
+    if ((status = run_accuracy_bind(&acfg, scene, frames, &acc)) ||
+        ((cfg->from || cfg->checkpoint_at) && (status = scene_fingerprint(cfg, scene, &fingerprint))) ||
+        (cfg->from && (status = checkpoint_read(cfg->from, sim, fingerprint)))) {
+        run_accuracy_free(&acc);
+        session_close(&ses);
+        return status;
+    }
+    if (cfg->from && sim->frame >= frames)
+        status = mpm_error(MPM_EINPUT, "--from %s starts at frame %d: --frames %d leaves nothing to run", cfg->from,
+                           sim->frame, frames);
+    else if (largest >= frames)
+        status = mpm_error(MPM_EINPUT, "--checkpoint-at %s: frame %d is not before the run's end (%d frames)",
+                           cfg->checkpoint_at, largest, frames);
+    else if (largest >= 0 && largest < sim->frame)
+        status = mpm_error(MPM_EINPUT, "--checkpoint-at %s: frame %d is before the checkpoint's frame %d",
+                           cfg->checkpoint_at, largest, sim->frame);
+    if (status) {
         run_accuracy_free(&acc);
         session_close(&ses);
         return status;
@@ -286,7 +381,7 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     if (!(frames_csv = open_in(out_dir, "frames.csv", &status))) goto done;
     if (cfg->history && !(iters_csv = open_in(out_dir, "iters.csv", &status))) goto done;
     if ((status = run_accuracy_open(&acc, out_dir, scene))) goto done;
-    write_run_json(out_dir, cfg, scene, solver, &set, &acc, frames, threads, &status);
+    write_run_json(out_dir, cfg, scene, solver, &set, &acc, frames, sim->frame, threads, &status);
     if (status) goto done;
     fprintf(steps_csv, "scene,solver,frame,step,t,dt,particles,active_nodes,hessian_blocks,outer_iters,linear_iters,"
                        "ls_evals,residual,status,wall_s,p2g_s,assemble_s,setup_s,solve_s,linesearch_s,g2p_s,threads,"
@@ -298,7 +393,7 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
             run_accuracy_frame_header);
     if (iters_csv) fprintf(iters_csv, "frame,step,iter,elapsed_s,residual,energy\n");
 
-    if (cfg->vtk_dir && (status = vtk_series_frame(&vtk, 0, sim->t, &sim->p, scene->materials, scene->n_materials,
+    if (cfg->vtk_dir && (status = vtk_series_frame(&vtk, sim->frame, sim->t, &sim->p, scene->materials, scene->n_materials,
                                                    NULL, NULL)))
         goto done;
     sum->particles = scene->particles.n;
@@ -310,7 +405,8 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
         printf("%6s %6s %8s %9s %9s %10s %12s  %s\n", "frame", "steps", "outer", "linear", "inner", "wall_s",
                "max_resid", "status");
     }
-    RunOutput out = {cfg, scene, solver, &acc, steps_csv, frames_csv, iters_csv, threads, cfg->vtk_dir ? &vtk : NULL};
+    RunOutput out = {cfg,     scene,   solver,      &acc, steps_csv, frames_csv, iters_csv, threads,
+                     cfg->vtk_dir ? &vtk : NULL, out_dir, fingerprint};
     FrameDriver driver = {.frames = frames,
                           .on_failure = cfg->on_failure,
                           .progress = 1,

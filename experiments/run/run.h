@@ -48,6 +48,9 @@ typedef struct {
     const char *trajectory_ref; /* --trajectory-ref RUN_DIR */
     int trajectory;             /* --trajectory: OUT/trajectory.bin */
     size_t max_particles;       /* particle budget (--max-particles); 0: scene_default_max_particles() */
+    /* checkpoints (experiments/io/checkpoint.h; NULL = none) */
+    const char *checkpoint_at;  /* --checkpoint-at F,F,...: OUT/checkpoints/frame_NNNN.ckpt at those frames' starts */
+    const char *from;           /* --from FILE: continue from a checkpoint, bit for bit */
 } RunConfig;
 
 typedef struct {
@@ -65,6 +68,9 @@ void run_session_config(const RunConfig *cfg, SessionConfig *sc, const char **li
  * no folder made): flags, limits, paths, the solver spec with its options
  * (solver_spec_check). MPM_EINPUT with one line naming the flag and value. */
 int run_config_check(const RunConfig *cfg);
+/* --checkpoint-at's value: frame numbers >= 0 separated by commas (at most
+ * RUN_MAX_LIST); MPM_EINPUT naming the flag and the text otherwise. */
+int run_check_frame_list(const char *text);
 /* The solve settings cfg asks for. */
 void run_solve_settings(const RunConfig *cfg, SolveSettings *set);
 int run_simulation(const RunConfig *cfg, RunSummary *sum);
