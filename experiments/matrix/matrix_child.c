@@ -14,7 +14,7 @@
 
 #include "core/error.h"
 #include "core/event_log.h"
-#include "experiments/matrix/machine_load.h"
+#include "experiments/io/machine_load.h"
 
 extern char **environ;
 

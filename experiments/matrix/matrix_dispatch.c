@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "core/error.h"
+#include "experiments/io/machine_load.h"
 #include "experiments/matrix/matrix_child.h"
 #include "experiments/matrix/matrix_results.h"
 #include "experiments/io/paths.h"
@@ -92,7 +93,7 @@ static int slot_poll(Slot *s, int rank, MatrixResult *r)
     cell_measure(s->task.dir, s->task.first_timed_frame, &r->measure);
     if (r->outcome.status == CELL_OK && r->measure.cut_short) r->outcome.status = CELL_TIME_LIMIT;
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    r->outcome.busy = cell_busy(r->outcome.others_cpu_s, r->outcome.elapsed_s, r->measure.threads_run, (int)cores);
+    r->outcome.busy = machine_was_busy(r->outcome.others_cpu_s, r->outcome.elapsed_s, r->measure.threads_run, (int)cores);
     s->busy = 0;
     return 1;
 }

@@ -48,12 +48,6 @@ static int severity(const char *s)
 
 static double num(const char *s) { return s[0] ? strtod(s, NULL) : 0.0; }
 
-int cell_busy(double others_cpu_s, double elapsed_s, int threads, int cores)
-{
-    if (others_cpu_s < 0 || elapsed_s <= 0 || cores <= 0) return 0;
-    int spare = threads > 0 && threads < cores ? cores - threads : 0;
-    return others_cpu_s > elapsed_s * (spare + 0.1);
-}
 
 /* A frame the run cut short at its time limit: frames.csv complete = 0, or
  * (files written before that column) status timeout for --max-run-seconds. */

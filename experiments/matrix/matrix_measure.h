@@ -22,7 +22,7 @@ typedef struct {
     double others_cpu_s;    /* CPU seconds the rest of the machine used meanwhile (/proc/stat busy
                                time, steal included, minus cpu_s); < 0: unknown */
     double load_start;      /* 1-minute load average when the cell started; < 0: unknown */
-    int busy;               /* others_cpu_s took more than the cores the cell left free (cell_busy) */
+    int busy;               /* others_cpu_s took more than the cores the cell left free (machine_was_busy) */
 } CellOutcome;
 
 typedef struct {
@@ -53,12 +53,6 @@ void cell_measure(const char *dir, int first_timed_frame, CellMeasure *m);
 /* The status of a child from its wait status (timed_out: the runner killed it). */
 CellOutcome cell_outcome(int wait_status, int timed_out, double elapsed_s, long peak_rss_kb);
 
-/* Was the machine busy while the cell ran? Other processes' CPU time above
- * the cores the cell left free (cores - threads) plus a tenth of a core on
- * average: with spinning OpenMP threads even a small share of a core taken
- * by another process can slow a cell many times (a descheduled thread holds
- * up its team at every barrier). */
-int cell_busy(double others_cpu_s, double elapsed_s, int threads, int cores);
 
 /* The measurement columns of cells.csv (names, and one row's values). */
 extern const char *const cell_measure_columns;

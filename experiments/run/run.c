@@ -8,12 +8,15 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "core/error.h"
+#include "core/event_log.h"
 #include "core/step.h"
 #include "core/scene/scene_load.h"
 #include "experiments/io/checkpoint.h"
 #include "experiments/io/csv_write.h"
+#include "experiments/io/machine_load.h"
 #include "experiments/driver/library_startup.h"
 #include "experiments/io/paths.h"
 #include "experiments/run/ply.h"
@@ -107,6 +110,50 @@ static int scene_fingerprint(const RunConfig *cfg, const Scene *scene, uint64_t 
     for (int i = 0; i < cfg->n_set; ++i) h = checkpoint_hash(h, cfg->set[i], strlen(cfg->set[i]) + 1);
     *fp = h;
     return MPM_OK;
+}
+
+/* The machine's load over a window of the run (experiments/io/machine_load.h). */
+typedef struct {
+    double busy0, cpu0, t0, load_start;
+    double others_cpu_s, elapsed_s;
+    int cores, busy;
+} LoadWindow;
+
+static void load_window_start(LoadWindow *w)
+{
+    w->busy0 = machine_busy_seconds();
+    w->cpu0 = process_cpu_seconds();
+    w->load_start = machine_load1();
+    w->t0 = event_clock();
+}
+
+static void load_window_end(LoadWindow *w, int threads)
+{
+    double busy1 = machine_busy_seconds(), cpu1 = process_cpu_seconds();
+    w->elapsed_s = event_clock() - w->t0;
+    w->cores = (int)sysconf(_SC_NPROCESSORS_ONLN);
+    w->others_cpu_s = -1.0;
+    if (w->busy0 >= 0 && busy1 >= 0 && w->cpu0 >= 0 && cpu1 >= 0) {
+        w->others_cpu_s = (busy1 - w->busy0) - (cpu1 - w->cpu0);
+        if (w->others_cpu_s < 0) w->others_cpu_s = 0.0; /* clock ticks of 10 ms against exact rusage */
+    }
+    w->busy = machine_was_busy(w->others_cpu_s, w->elapsed_s, threads, w->cores);
+}
+
+/* run.json gets "machine_load" once the frames have run. */
+static int add_machine_load(const char *dir, const LoadWindow *w)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/run.json", dir);
+    json_t *root = json_load_file(path, JSON_DECODE_ANY, NULL);
+    json_t *load = json_pack("{s:f, s:f, s:f, s:i, s:b}", "others_cpu_s", w->others_cpu_s, "elapsed_s", w->elapsed_s,
+                             "load_start", w->load_start, "cores", w->cores, "machine_busy", w->busy);
+    int st = MPM_OK;
+    if (!root || !load || json_object_set_new(root, "machine_load", load) ||
+        json_dump_file(root, path, JSON_INDENT(2) | JSON_PRESERVE_ORDER) != 0)
+        st = mpm_error(MPM_EINPUT, "%s: cannot write", path);
+    json_decref(root);
+    return st;
 }
 
 static AccuracyConfig accuracy_config(const RunConfig *cfg)
@@ -418,7 +465,12 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
                           .iteration = write_iteration,
                           .ctx = &out};
     char stop_reason[300];
+    /* the machine's load while the frames run: a time taken while other
+     * processes used the cores the run needed is not a valid time */
+    LoadWindow load;
+    load_window_start(&load);
     if ((status = frame_driver_run(&driver, sim, solver, &set, &sum->totals, stop_reason, sizeof stop_reason))) goto done;
+    load_window_end(&load, threads);
     fflush(steps_csv);
     fflush(frames_csv);
     const DriveTotals *tot = &sum->totals;
@@ -430,6 +482,13 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
                tot->frames ? tot->wall_s / tot->frames : 0.0, solve_status_name((SolveStatus)tot->worst_status));
         printf("wrote %s/steps.csv and %s/frames.csv%s\n", out_dir, out_dir, iters_csv ? " and iters.csv" : "");
     }
+    if (load.busy)
+        fprintf(stderr,
+                "mpmbench: warning: other processes used %.1f CPU-seconds of the run's %.1f s on %d cores while it "
+                "ran on %d thread%s: its times are not valid (machine_load in run.json; on a shared machine "
+                "run with fewer threads, or OMP_WAIT_POLICY=passive)\n",
+                load.others_cpu_s, load.elapsed_s, load.cores, threads, threads == 1 ? "" : "s");
+    if ((status = add_machine_load(out_dir, &load))) goto done;
     /* the parts' statistics through the view op: the hierarchy of the last
      * setup (HOT Fig. 8: blocks per row per level; none when every step
      * converged at its initial guess) and the named statistics */

@@ -24,6 +24,7 @@
 #include <unistd.h>
 
 #include "core/error.h"
+#include "experiments/io/machine_load.h"
 #include "experiments/matrix/matrix_cells.h"
 #include "experiments/matrix/matrix_child.h"
 #include "experiments/io/csv_table.h"
@@ -125,9 +126,9 @@ static void test_outcome(void)
               !strcmp(cell_status_name(CELL_TIME_LIMIT), "time-limit"),
           "names");
     /* busy: other processes' CPU over (cores - threads + 0.1) x elapsed */
-    CHECK(!cell_busy(0.19, 2.0, 2, 2) && cell_busy(0.21, 2.0, 2, 2), "2 threads on 2 cores: a tenth of a core is busy");
-    CHECK(!cell_busy(2.19, 2.0, 1, 2) && cell_busy(2.21, 2.0, 1, 2), "1 thread on 2 cores: the free core may be used");
-    CHECK(cell_busy(0.3, 2.0, 0, 2) && !cell_busy(-1.0, 2.0, 2, 2) && !cell_busy(5.0, 0.0, 2, 2),
+    CHECK(!machine_was_busy(0.19, 2.0, 2, 2) && machine_was_busy(0.21, 2.0, 2, 2), "2 threads on 2 cores: a tenth of a core is busy");
+    CHECK(!machine_was_busy(2.19, 2.0, 1, 2) && machine_was_busy(2.21, 2.0, 1, 2), "1 thread on 2 cores: the free core may be used");
+    CHECK(machine_was_busy(0.3, 2.0, 0, 2) && !machine_was_busy(-1.0, 2.0, 2, 2) && !machine_was_busy(5.0, 0.0, 2, 2),
           "threads unknown: no core free; unknown load or no time: not busy");
 }
 

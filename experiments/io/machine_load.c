@@ -1,6 +1,7 @@
-#include "experiments/matrix/machine_load.h"
+#include "experiments/io/machine_load.h"
 
 #include <stdio.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 double machine_busy_seconds(void)
@@ -25,4 +26,19 @@ double machine_load1(void)
     if (fscanf(f, "%lf", &load) != 1) load = -1.0;
     fclose(f);
     return load;
+}
+
+int machine_was_busy(double others_cpu_s, double elapsed_s, int threads, int cores)
+{
+    if (others_cpu_s < 0 || elapsed_s <= 0 || cores <= 0) return 0;
+    int spare = threads > 0 && threads < cores ? cores - threads : 0;
+    return others_cpu_s > elapsed_s * (spare + 0.1);
+}
+
+double process_cpu_seconds(void)
+{
+    struct rusage ru;
+    if (getrusage(RUSAGE_SELF, &ru) != 0) return -1.0;
+    return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_sec +
+           1e-6 * (double)ru.ru_stime.tv_usec;
 }
