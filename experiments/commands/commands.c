@@ -191,6 +191,30 @@ void cli_program_usage(FILE *f)
                "                     as the scenes are)\n");
 }
 
+/* mpmbench GROUP --help ("matrix"): the group's commands, each with its synopsis and summary. */
+static void group_usage(const char *group, FILE *f)
+{
+    size_t len = strlen(group);
+    fprintf(f, "usage: mpmbench %s COMMAND ...    (mpmbench %s COMMAND --help: its options)\n\ncommands:\n", group,
+            group);
+    for (int i = 0; cli_commands[i]; ++i)
+        if (!strncmp(cli_commands[i]->name, group, len) && cli_commands[i]->name[len] == ' ') {
+            fprintf(f, "  ");
+            cli_synopsis(cli_commands[i], f);
+            fprintf(f, "\n      ");
+            cli_wrap(f, 6, 6, cli_commands[i]->summary);
+        }
+}
+
+/* Is word the first word of two-word commands ("matrix")? */
+static int is_group(const char *word)
+{
+    size_t len = strlen(word);
+    for (int i = 0; cli_commands[i]; ++i)
+        if (!strncmp(cli_commands[i]->name, word, len) && cli_commands[i]->name[len] == ' ') return 1;
+    return 0;
+}
+
 static int help_wanted(const char *a) { return !strcmp(a, "--help") || !strcmp(a, "-h") || !strcmp(a, "help"); }
 
 /* The command argv names from argv[1] on ("matrix run" takes two words); *words how many. */
@@ -223,9 +247,9 @@ static const Command *find_command(int argc, char **argv, int *words, int *statu
             len += (size_t)snprintf(choices + len, sizeof choices - len, "%s'%s'", sep, cli_commands[i]->name + strlen(group));
             ++n;
         }
-    if (n && argc > 2 && help_wanted(argv[2])) return NULL; /* mpmbench matrix --help: the program's usage */
+    if (n && argc > 2 && help_wanted(argv[2])) return NULL; /* mpmbench matrix --help: the group's usage */
     if (!n) *status = mpm_error(MPM_EINPUT, "unknown command '%s' (see: mpmbench --help)", argv[1]);
-    else if (argc < 3) *status = mpm_error(MPM_EINPUT, "%s: expected %s (see: mpmbench --help)", argv[1], choices);
+    else if (argc < 3) *status = mpm_error(MPM_EINPUT, "%s: expected %s (see: mpmbench %s --help)", argv[1], choices, argv[1]);
     else *status = mpm_error(MPM_EINPUT, "%s '%s': expected %s", argv[1], argv[2], choices);
     return NULL;
 }
@@ -247,6 +271,10 @@ int cli_main(int argc, char **argv)
         return CLI_EXIT_OK;
     }
     int help_first = help_wanted(argv[1]); /* mpmbench help COMMAND */
+    if (help_first && argc == 3 && is_group(argv[2])) {
+        group_usage(argv[2], stdout); /* mpmbench help matrix */
+        return CLI_EXIT_OK;
+    }
     int first = help_first ? 2 : 1, words = 0, exit_code = CLI_EXIT_OK;
     int st = threads_check_env(); /* before OpenMP reads it at the first parallel region */
     const Command *cmd = st ? NULL : find_command(argc - first + 1, argv + first - 1, &words, &st);
@@ -264,7 +292,7 @@ int cli_main(int argc, char **argv)
         else if (!st) st = cmd->run(args, operand, &exit_code);
         free(args);
     } else if (!st && argc > first + 1 && help_wanted(argv[first + 1])) {
-        cli_program_usage(stdout); /* mpmbench matrix --help */
+        group_usage(argv[first], stdout); /* mpmbench matrix --help */
         return CLI_EXIT_OK;
     }
     if (st) {
