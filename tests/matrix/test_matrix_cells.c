@@ -130,6 +130,8 @@ static void test_outcome(void)
     CHECK(!machine_was_busy(2.19, 2.0, 1, 2) && machine_was_busy(2.21, 2.0, 1, 2), "1 thread on 2 cores: the free core may be used");
     CHECK(machine_was_busy(0.3, 2.0, 0, 2) && !machine_was_busy(-1.0, 2.0, 2, 2) && !machine_was_busy(5.0, 0.0, 2, 2),
           "threads unknown: no core free; unknown load or no time: not busy");
+    CHECK(!machine_was_busy(0.04, 0.01, 2, 2) && machine_was_busy(0.06, 0.01, 2, 2),
+          "a short window: others' time under the counters' resolution is not busy");
 }
 
 /* cell_measure on a hand-made cell directory: a frame the run's time limit
