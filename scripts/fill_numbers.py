@@ -324,6 +324,12 @@ def dec_spread(study, solver, eps):
     return f"{max(vals) / min(vals):.0f}x ({sig(min(vals), 2)} to {sig(max(vals), 2)}, {len(vals)} scenes)"
 
 
+def dec_egap_over_eps(scene, solver, eps):
+    """e_gap / eps of a decrement cell: how far the rule's promise held."""
+    r = one("decrement", "wp.csv", case=scene, solver=solver, eps=eps)
+    return sig(num(r, "e_gap_median") / float(eps), 2)
+
+
 def check_passed(study):
     c = table(study, "check.csv")
     return of(sum(r["pass"] == "1" for r in c), len(c))
@@ -542,6 +548,7 @@ NUMBERS = {
     "dec.pn-pcg_dec_1e-4": lambda: dec_spread("decrement", "pn-pcg:stop=decrement", 1e-4),
     "dec.hot_cn_1e-6": lambda: dec_spread("work-precision", "hot", 1e-6),
     "dec.hot_dec_1e-4": lambda: dec_spread("decrement", "hot:stop=decrement", 1e-4),
+    "dec.twist_egap_over_eps_1e-8": lambda: dec_egap_over_eps("twist", "pn-pcg:stop=decrement", "1e-08"),
     "stress.cells": lambda: cells_ok("stress"),
     "stress.date": lambda: run_date("stress"),
     "stress.passed": lambda: check_passed("stress"),
