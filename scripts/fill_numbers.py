@@ -330,6 +330,32 @@ def dec_egap_over_eps(scene, solver, eps):
     return sig(num(r, "e_gap_median") / float(eps), 2)
 
 
+def omp_wait_median(load, wait):
+    """Median s/frame of results/omp-wait's runs of one wait setting under
+    one load (idle runs only when the machine was quiet)."""
+    v = [num(r, "s_per_frame") for r in rows("omp-wait", "runs.csv", load=load, wait=wait)
+         if load != "idle" or r["machine_busy"] == "0"]
+    if not v:
+        raise Missing(f"results/omp-wait: no quiet {load} run of {wait}")
+    return statistics.median(v)
+
+
+def omp_wait_date():
+    r = rows("omp-wait", "runs.csv")[0]
+    with open(os.path.join(RESULTS, "omp-wait", r["dir"], "run.json")) as f:
+        return json.load(f)["provenance"]["start_time"][:10]
+
+
+def omp_wait_ratio(load, wait, base_load, base_wait):
+    return sig(omp_wait_median(load, wait) / omp_wait_median(base_load, base_wait), 3)
+
+
+def omp_wait_spread(load, wait):
+    v = [num(r, "s_per_frame") for r in rows("omp-wait", "runs.csv", load=load, wait=wait)
+         if load != "idle" or r["machine_busy"] == "0"]
+    return f"{sig(min(v), 3)}-{sig(max(v), 3)} s"
+
+
 def check_passed(study):
     c = table(study, "check.csv")
     return of(sum(r["pass"] == "1" for r in c), len(c))
@@ -549,6 +575,23 @@ NUMBERS = {
     "dec.hot_cn_1e-6": lambda: dec_spread("work-precision", "hot", 1e-6),
     "dec.hot_dec_1e-4": lambda: dec_spread("decrement", "hot:stop=decrement", 1e-4),
     "dec.twist_egap_over_eps_1e-8": lambda: dec_egap_over_eps("twist", "pn-pcg:stop=decrement", "1e-08"),
+    "ompwait.idle_spin10k_vs_default": lambda: omp_wait_ratio("idle", "spin10k", "idle", "omp_default"),
+    "ompwait.idle_spin1k_vs_default": lambda: omp_wait_ratio("idle", "spin1k", "idle", "omp_default"),
+    "ompwait.idle_passive_vs_default": lambda: omp_wait_ratio("idle", "passive", "idle", "omp_default"),
+    "ompwait.busy_omp_default_vs_idle": lambda: omp_wait_ratio("one-core-busy", "omp_default", "idle", "omp_default"),
+    "ompwait.idle_omp_default_spread": lambda: omp_wait_spread("idle", "omp_default"),
+    "ompwait.busy_omp_default_spread": lambda: omp_wait_spread("one-core-busy", "omp_default"),
+    "ompwait.busy_spin10k_vs_idle": lambda: omp_wait_ratio("one-core-busy", "spin10k", "idle", "spin10k"),
+    "ompwait.idle_spin10k_spread": lambda: omp_wait_spread("idle", "spin10k"),
+    "ompwait.busy_spin10k_spread": lambda: omp_wait_spread("one-core-busy", "spin10k"),
+    "ompwait.busy_spin1k_vs_idle": lambda: omp_wait_ratio("one-core-busy", "spin1k", "idle", "spin1k"),
+    "ompwait.idle_spin1k_spread": lambda: omp_wait_spread("idle", "spin1k"),
+    "ompwait.busy_spin1k_spread": lambda: omp_wait_spread("one-core-busy", "spin1k"),
+    "ompwait.busy_passive_vs_idle": lambda: omp_wait_ratio("one-core-busy", "passive", "idle", "passive"),
+    "ompwait.idle_passive_spread": lambda: omp_wait_spread("idle", "passive"),
+    "ompwait.busy_passive_spread": lambda: omp_wait_spread("one-core-busy", "passive"),
+    "ompwait.idle_default_s": lambda: sig(omp_wait_median("idle", "omp_default"), 3),
+    "ompwait.date": lambda: omp_wait_date(),
     "stress.cells": lambda: cells_ok("stress"),
     "stress.date": lambda: run_date("stress"),
     "stress.passed": lambda: check_passed("stress"),
@@ -624,7 +667,7 @@ NUMBERS = {
 # one run per cell cannot carry them. Iteration counts, accuracy and counts of
 # cells are the same on every run and are not in this set.
 RANKING = {k for k in NUMBERS if re.search(
-    r"(fastest|tied|geomean|_range$|within|_vs_|time_ratio|lead_|_over_|"
+    r"(fastest|tied|geomean|_range$|within|_vs_|time_ratio|lead_|_over_|^ompwait\.(idle|busy)|"
     r"^sp\.(hot|mgpcg|gmg)|^hotstep\.|^fig18\.gast15|_over_|sgs_speed|mf_speedup)", k)}
 
 
@@ -651,7 +694,7 @@ def study_state(study):
     cells.csv cannot be checked and is never current."""
     if study not in _status:
         d = os.path.join(RESULTS, study)
-        if os.path.isfile(os.path.join(d, "cells.csv")):
+        if any(os.path.isfile(os.path.join(d, f)) for f in ("cells.csv", "runs.csv")):
             try:
                 _status[study] = study_status.status(d, binary())
             except (RuntimeError, OSError) as e:
@@ -666,7 +709,7 @@ def status_text(study):
     """The one-line status of a study, the text of its s: marker."""
     s = study_state(study)
     if s.get("no_cells"):
-        return (f"{study}: not a matrix study (no cells.csv), so its build, machine and solver definitions "
+        return (f"{study}: not a matrix study (no cells.csv or runs.csv), so its build, machine and solver definitions "
                 f"are not recorded per run and it cannot be shown current: kept for history")
     when = " to ".join(sorted(set(s["dates"]))) if s["dates"] else "date not recorded"
     build = "+".join(s["builds"]) or "build not recorded"

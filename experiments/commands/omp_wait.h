@@ -11,7 +11,7 @@
 /* The GOMP_SPINCOUNT the program runs with when the user set neither
  * OMP_WAIT_POLICY nor GOMP_SPINCOUNT (docs/outputs.md, "Threads and a
  * shared machine", has the measurement behind it). */
-#define MPM_DEFAULT_SPINCOUNT "10000"
+#define MPM_DEFAULT_SPINCOUNT "1000"
 
 /* When the user left OMP_WAIT_POLICY and GOMP_SPINCOUNT unset (and
  * MPM_KEEP_OMP_WAIT is unset), sets GOMP_SPINCOUNT to the default and
