@@ -747,6 +747,10 @@ static void petsc_view(const InvApprox *self, FILE *f, InvView *out)
     inv_view_add(out, "levels", levels);
     inv_view_add(out, "operator_complexity", cx);
     inv_view_add(out, "library_threads", 1);
+    if (out && s->ksp && petsc_view_text(self, out->library_view, sizeof out->library_view) != MPM_OK) {
+        mpm_clear_error();
+        out->library_view[0] = '\0';
+    }
 }
 
 const InvApproxOps inv_petsc_ops = {"petsc",       "PETSc's KSP and PC (default: one GAMG V-cycle with rigid-body modes)",
