@@ -122,6 +122,9 @@ for inv in invs:
     path = os.path.join(tmp, f"inv-{inv}", "run.json")
     if os.path.exists(path):
         written |= set(json.load(open(path)))
+# inverse_view comes from the petsc adapter alone: a build without it writes none
+if "petsc" not in invs:
+    written.add("inverse_view")
 for k in rows:
     if k not in written:
         bad.append(f"run.json: field '{k}' is documented but not written")
