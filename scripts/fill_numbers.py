@@ -15,7 +15,29 @@ HTML comments, so they do not show in rendered markdown.
                                               text differs from the results
     python3 scripts/fill_numbers.py --list    print every key and its value
 
-Files: README.md, results/README.md, docs/*.md, or the files given after the
+Trust rules. Every key records the studies it reads. A number may be quoted
+as current (`n:`) only when every study it reads is current (no solver of it
+is stale: scripts/study_status.py), none of the rows it reads ran on a busy
+machine (machine_busy), and, for a key that ranks solvers (RANKING), every
+study it reads has at least two runs of each cell. Any other number is
+history: it is quoted with an `h:` marker,
+
+    HOT was the fastest on <!-- h:scenes.hot_fastest -->10 of 13<!-- /n --> scenes
+
+and its section (from the heading before it to the next) carries the status
+of every study it reads, a generated marker
+
+    <!-- s:scenes-bench -->scenes-bench: build 24f0c85, ... stale ...<!-- /n -->
+
+An `n:` marker whose number is not current, an `h:` marker without its
+studies' status in its section, and an `h:` marker whose number is current
+(quote it as `n:`) are errors. Every study that is not current says so on the
+first line of its page (results/STUDY/README.md, else report.md) with its
+status marker (--write puts it there). Staleness is judged by the build at
+MPM_BINARY (default build/mpmbench).
+
+Files: README.md, results/README.md, docs/*.md and the study pages
+results/*/README.md and report.md, or the files given after the
 mode (`--check FILE ...`). A marker with an unknown key,
 or a key whose data is missing, is an error in every mode. The test suite runs
 --check (tests/matrix/test_fill_numbers.sh), so a regenerated report that
@@ -31,9 +53,13 @@ import re
 import statistics
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import study_status  # noqa: E402
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RESULTS = os.path.join(ROOT, "results")
-MARKER = re.compile(r"<!-- n:([A-Za-z0-9_.+-]+) -->(.*?)<!-- /n -->", re.S)
+MARKER = re.compile(r"<!-- ([nhs]):([A-Za-z0-9_.+-]+) -->(.*?)<!-- /n -->", re.S)
+HEADING = re.compile(r"^(#{1,6}) ", re.M)
 PAPER_SCENES = ["twist", "boxes", "donut", "armacat-soft", "armacat-stiff", "chain", "boards", "wheel",
                 "faceless", "sauce"]
 
@@ -45,9 +71,16 @@ class Missing(Exception):
 # ---- reading ---------------------------------------------------------------
 
 _cache = {}
+# what the key being computed reads: its studies and whether a row it read ran busy
+_reading = {"studies": set(), "busy": set()}
+
+
+def reads(study):
+    _reading["studies"].add(study)
 
 
 def table(study, name):
+    reads(study)
     path = os.path.join(RESULTS, study, name)
     if path not in _cache:
         if not os.path.exists(path):
@@ -62,6 +95,8 @@ def rows(study, name="report.csv", **where):
     out = [r for r in table(study, name) if all(r.get(k) == v for k, v in where.items())]
     if not out:
         raise Missing(f"results/{study}/{name}: no row with {where}")
+    if any(r.get("machine_busy") not in (None, "", "0") for r in out):
+        _reading["busy"].add(study)
     return out
 
 
@@ -82,6 +117,7 @@ def num(r, col):
 
 def summary(study):
     """DIR/summary.json, the report's answer in numbers (scripts/matrix_report.py)."""
+    reads(study)
     path = os.path.join(RESULTS, study, "summary.json")
     if path not in _cache:
         if not os.path.exists(path):
@@ -99,6 +135,7 @@ def solver_summary(study, solver):
 
 
 def provenance(study):
+    reads(study)
     path = os.path.join(RESULTS, study, "provenance.json")
     if not os.path.exists(path):
         raise Missing(f"results/{study}/provenance.json does not exist")
@@ -219,6 +256,38 @@ def stiffness_iters(solver):
     return f"{lo:.0f} to {hi:.0f}"
 
 
+def scenes_hot_not_fastest(what="list"):
+    """The scenes of scenes-bench where another solver is faster than HOT by
+    more than the 1.1x noise band: that solver and by how much, or HOT's
+    L-BFGS iterations against PN-PCG's Newton iterations there."""
+    by = {}
+    for r in table("scenes-bench", "report.csv"):
+        if r["status"] == "ok" and r["worst_status"] == "converged":
+            by.setdefault(r["scene"], {})[r["solver"]] = r
+    out = []
+    for sc in sorted(by):
+        d = by[sc]
+        if "hot" not in d:
+            continue
+        best = min(d, key=lambda s: num(d[s], "s_per_frame"))
+        ratio = num(d["hot"], "s_per_frame") / num(d[best], "s_per_frame")
+        if ratio > 1.1:
+            if what == "iters":
+                out.append(f"{sc} {num(d['hot'], 'outer_iters'):.0f} against {num(d['pn-pcg'], 'outer_iters'):.0f}")
+            else:
+                out.append(f"{sc} ({best}, {sig(ratio, 3)}x faster)")
+    if not out:
+        raise Missing("results/scenes-bench: HOT is within the noise of the fastest on every scene")
+    return ", ".join(out)
+
+
+def stiffness_ratio(fast, slow, modulus):
+    """slow's s/frame over fast's on bar3 at one middle-segment modulus."""
+    a = num(one("stiffness", case=f"bar3 stiffness={modulus}", solver=slow), "s_per_frame")
+    b = num(one("stiffness", case=f"bar3 stiffness={modulus}", solver=fast), "s_per_frame")
+    return sig(a / b, 3)
+
+
 def wp_err_h_range(eps):
     vals = [float(r["err_h_median"]) for r in table("work-precision", "wp.csv")
             if r["status"] == "ok" and r["eps"] and float(r["eps"]) == eps and r["err_h_median"]]
@@ -253,6 +322,38 @@ def dec_spread(study, solver, eps):
     if len(vals) < 2 or min(vals) <= 0:
         raise Missing(f"results/{study}/wp.csv: fewer than two scenes for {solver} at eps {eps}")
     return f"{max(vals) / min(vals):.0f}x ({sig(min(vals), 2)} to {sig(max(vals), 2)}, {len(vals)} scenes)"
+
+
+def dec_egap_over_eps(scene, solver, eps):
+    """e_gap / eps of a decrement cell: how far the rule's promise held."""
+    r = one("decrement", "wp.csv", case=scene, solver=solver, eps=eps)
+    return sig(num(r, "e_gap_median") / float(eps), 2)
+
+
+def omp_wait_median(load, wait):
+    """Median s/frame of results/omp-wait's runs of one wait setting under
+    one load (idle runs only when the machine was quiet)."""
+    v = [num(r, "s_per_frame") for r in rows("omp-wait", "runs.csv", load=load, wait=wait)
+         if load != "idle" or r["machine_busy"] == "0"]
+    if not v:
+        raise Missing(f"results/omp-wait: no quiet {load} run of {wait}")
+    return statistics.median(v)
+
+
+def omp_wait_date():
+    r = rows("omp-wait", "runs.csv")[0]
+    with open(os.path.join(RESULTS, "omp-wait", r["dir"], "run.json")) as f:
+        return json.load(f)["provenance"]["start_time"][:10]
+
+
+def omp_wait_ratio(load, wait, base_load, base_wait):
+    return sig(omp_wait_median(load, wait) / omp_wait_median(base_load, base_wait), 3)
+
+
+def omp_wait_spread(load, wait):
+    v = [num(r, "s_per_frame") for r in rows("omp-wait", "runs.csv", load=load, wait=wait)
+         if load != "idle" or r["machine_busy"] == "0"]
+    return f"{sig(min(v), 3)}-{sig(max(v), 3)} s"
 
 
 def check_passed(study):
@@ -323,6 +424,26 @@ def baselines_lead(threads, what="geo"):
     return sig(math.exp(sum(math.log(x) for x in ratios) / len(ratios)), 3)
 
 
+def baselines_repeat_lead(threads, what="geo"):
+    """baselines_lead from results/baselines-repeat: each cell's median over
+    its repeats (converged, quiet runs) in place of one run."""
+    times = {}
+    for r in table("baselines-repeat", "cells.csv"):
+        if (r["threads"] == str(threads) and r["status"] == "ok" and r["worst_solve_status"] == "converged"
+                and r.get("machine_busy", "0") != "1"):
+            times.setdefault((r["scene"], r["solver"]), []).append(float(r["s_per_frame"]))
+    ratios = []
+    for sc in sorted({k[0] for k in times}):
+        alg = [statistics.median(times[(sc, s)]) for s in ALGEBRAIC if (sc, s) in times]
+        if (sc, "hot") in times and alg:
+            ratios.append(min(alg) / statistics.median(times[(sc, "hot")]))
+    if not ratios:
+        raise Missing(f"results/baselines-repeat: no scene with hot and an algebraic multigrid at {threads} threads")
+    if what == "range":
+        return span(ratios, 3)
+    return sig(math.exp(sum(math.log(x) for x in ratios) / len(ratios)), 3)
+
+
 def fig18_speedup(scene, solver="gast15"):
     return sig(num(one("gast15-fig18", scene=scene, solver=solver), "speedup_total"))
 
@@ -388,6 +509,7 @@ def foundation_mf():
 
 
 def foundation_bench(key, digits=3):
+    reads("foundation")
     path = os.path.join(RESULTS, "foundation", "bench.txt")
     if not os.path.exists(path):
         raise Missing("results/foundation/bench.txt does not exist")
@@ -427,6 +549,12 @@ NUMBERS = {
     "scenes.pn-mgpcg_vs_pn-pcg_paper": lambda: scenes_speedup("pn-mgpcg", PAPER_SCENES),
     "scenes.pn-amg-pcg_vs_pn-pcg_all": lambda: scenes_speedup(
         "pn-amg-pcg", sorted({r["scene"] for r in table("scenes-bench", "report.csv")})),
+    "choose.hot_not_fastest": scenes_hot_not_fastest,
+    "choose.hot_not_fastest_iters": lambda: scenes_hot_not_fastest("iters"),
+    "choose.soft_mf_over_hot": lambda: stiffness_ratio("pn-pcg-mf", "hot", "1e+05"),
+    "choose.stiff_hot_over_mf": lambda: stiffness_ratio("hot", "pn-pcg-mf", "1e+09"),
+    "choose.stiff_hot_over_mgpcg": lambda: stiffness_ratio("hot", "pn-mgpcg", "1e+09"),
+    "stiffness.hot_vs_pn-pcg_1e5": lambda: stiffness_speedup("hot", "1e+05"),
     "mpi.cells": lambda: cells_ok("scenes-mpi2x1"),
     "mpi.date": lambda: run_date("scenes-mpi2x1"),
     "mpi.n_scenes": lambda: str(len({r["scene"] for r in table("scenes-mpi2x1", "cells.csv")})),
@@ -446,6 +574,24 @@ NUMBERS = {
     "dec.pn-pcg_dec_1e-4": lambda: dec_spread("decrement", "pn-pcg:stop=decrement", 1e-4),
     "dec.hot_cn_1e-6": lambda: dec_spread("work-precision", "hot", 1e-6),
     "dec.hot_dec_1e-4": lambda: dec_spread("decrement", "hot:stop=decrement", 1e-4),
+    "dec.twist_egap_over_eps_1e-8": lambda: dec_egap_over_eps("twist", "pn-pcg:stop=decrement", "1e-08"),
+    "ompwait.idle_spin10k_vs_default": lambda: omp_wait_ratio("idle", "spin10k", "idle", "omp_default"),
+    "ompwait.idle_spin1k_vs_default": lambda: omp_wait_ratio("idle", "spin1k", "idle", "omp_default"),
+    "ompwait.idle_passive_vs_default": lambda: omp_wait_ratio("idle", "passive", "idle", "omp_default"),
+    "ompwait.busy_omp_default_vs_idle": lambda: omp_wait_ratio("one-core-busy", "omp_default", "idle", "omp_default"),
+    "ompwait.idle_omp_default_spread": lambda: omp_wait_spread("idle", "omp_default"),
+    "ompwait.busy_omp_default_spread": lambda: omp_wait_spread("one-core-busy", "omp_default"),
+    "ompwait.busy_spin10k_vs_idle": lambda: omp_wait_ratio("one-core-busy", "spin10k", "idle", "spin10k"),
+    "ompwait.idle_spin10k_spread": lambda: omp_wait_spread("idle", "spin10k"),
+    "ompwait.busy_spin10k_spread": lambda: omp_wait_spread("one-core-busy", "spin10k"),
+    "ompwait.busy_spin1k_vs_idle": lambda: omp_wait_ratio("one-core-busy", "spin1k", "idle", "spin1k"),
+    "ompwait.idle_spin1k_spread": lambda: omp_wait_spread("idle", "spin1k"),
+    "ompwait.busy_spin1k_spread": lambda: omp_wait_spread("one-core-busy", "spin1k"),
+    "ompwait.busy_passive_vs_idle": lambda: omp_wait_ratio("one-core-busy", "passive", "idle", "passive"),
+    "ompwait.idle_passive_spread": lambda: omp_wait_spread("idle", "passive"),
+    "ompwait.busy_passive_spread": lambda: omp_wait_spread("one-core-busy", "passive"),
+    "ompwait.idle_default_s": lambda: sig(omp_wait_median("idle", "omp_default"), 3),
+    "ompwait.date": lambda: omp_wait_date(),
     "stress.cells": lambda: cells_ok("stress"),
     "stress.date": lambda: run_date("stress"),
     "stress.passed": lambda: check_passed("stress"),
@@ -466,6 +612,17 @@ NUMBERS = {
     "base.lead_2t_n": lambda: baselines_lead(2, "n"),
     "base.lead_1t": lambda: baselines_lead(1),
     "base.lead_1t_range": lambda: baselines_lead(1, "range"),
+    "brep.date": lambda: run_date("baselines-repeat"),
+    "brep.cells": lambda: cells_ok("baselines-repeat"),
+    "brep.lead_2t_range": lambda: baselines_repeat_lead(2, "range"),
+    "amgt.date": lambda: run_date("amg-tuning"),
+    "amgt.cells": lambda: cells_ok("amg-tuning"),
+    "mlt.date": lambda: run_date("ml-tuning"),
+    "mlt.cells": lambda: cells_ok("ml-tuning"),
+    "reuse.date": lambda: run_date("reuse"),
+    "reuse.cells": lambda: cells_ok("reuse"),
+    "base.repeat_lead_2t": lambda: baselines_repeat_lead(2),
+    "base.repeat_lead_1t": lambda: baselines_repeat_lead(1),
     "mls.time_ratio_pn-pcg": lambda: mls_time_ratio("pn-pcg"),
     "paper.cells": lambda: cells_ok("paper-scale"),
     "paper.date": lambda: run_date("paper-scale"),
@@ -506,16 +663,171 @@ NUMBERS = {
 }
 
 
+# Keys that rank solvers by time (a speed ratio, a fastest count, a lead):
+# one run per cell cannot carry them. Iteration counts, accuracy and counts of
+# cells are the same on every run and are not in this set.
+RANKING = {k for k in NUMBERS if re.search(
+    r"(fastest|tied|geomean|_range$|within|_vs_|time_ratio|lead_|_over_|^ompwait\.(idle|busy)|"
+    r"^sp\.(hot|mgpcg|gmg)|^hotstep\.|^fig18\.gast15|_over_|sgs_speed|mf_speedup)", k)}
+
+
 def value(key):
+    """The key's text and what it read: (text, {studies})."""
     if key not in NUMBERS:
         raise Missing(f"unknown key '{key}' (keys: scripts/fill_numbers.py NUMBERS)")
-    return NUMBERS[key]()
+    _reading["studies"], _reading["busy"] = set(), set()
+    text = NUMBERS[key]()
+    return text, set(_reading["studies"])
+
+
+# ---- trust -------------------------------------------------------------------
+
+_status = {}
+
+
+def binary():
+    return os.environ.get("MPM_BINARY") or study_status.DEFAULT_BINARY
+
+
+def study_state(study):
+    """scripts/study_status.py's verdict on results/STUDY; a folder without
+    cells.csv cannot be checked and is never current."""
+    if study not in _status:
+        d = os.path.join(RESULTS, study)
+        if any(os.path.isfile(os.path.join(d, f)) for f in ("cells.csv", "runs.csv")):
+            try:
+                _status[study] = study_status.status(d, binary())
+            except (RuntimeError, OSError) as e:
+                raise Missing(f"results/{study}: its status cannot be judged: {e}")
+        else:
+            _status[study] = {"study": study, "cells": 0, "current": False, "no_cells": True, "busy_cells": 0,
+                              "repeats": 0, "stale_solvers": []}
+    return _status[study]
+
+
+def status_text(study):
+    """The one-line status of a study, the text of its s: marker."""
+    s = study_state(study)
+    if s.get("no_cells"):
+        return (f"{study}: not a matrix study (no cells.csv or runs.csv), so its build, machine and solver definitions "
+                f"are not recorded per run and it cannot be shown current: kept for history")
+    when = " to ".join(sorted(set(s["dates"]))) if s["dates"] else "date not recorded"
+    build = "+".join(s["builds"]) or "build not recorded"
+    machine = "/".join(s["machines"]) or "machine not recorded"
+    cores = "/".join(str(c) for c in s["cores"])
+    runs = f"{s['repeats']} run{'s' if s['repeats'] != 1 else ''} per cell"
+    busy = f"{s['busy_cells']} busy cells" if s["busy_recorded"] else "machine load not recorded"
+    if s["current"]:
+        state = "current"
+    else:
+        n = len(s["stale_solvers"])
+        state = f"stale for {n} solver setting{'s' if n != 1 else ''} ({', '.join(s['stale_solvers'][:3])}" + \
+                (", ..." if n > 3 else "") + "): kept for history"
+    return (f"{study}: build {build}{' (modified tree)' if s['modified_tree'] else ''}, {when}, {machine}"
+            f"{', ' + cores + ' cores' if cores else ''}, {runs}, {busy}; {state}")
+
+
+# Keys that describe a study (when, where, what it covered), not a result of it.
+DESCRIPTIVE = re.compile(r"\.(date|cpu|cores|minutes|n_scenes|n_solvers)$")
+
+
+def doubts(key, studies):
+    """Why the key's number is not a current one ([] when it is)."""
+    out = []
+    if DESCRIPTIVE.search(key):
+        return out
+    for st in sorted(studies):
+        s = study_state(st)
+        if not s["current"]:
+            out.append(f"results/{st} is not current")
+        if s.get("busy_cells"):
+            out.append(f"results/{st} has {s['busy_cells']} cells that ran on a busy machine")
+        if key in RANKING and s["repeats"] < 2:
+            out.append(f"it ranks solvers by time and results/{st} has one run per cell")
+    return out
+
+
+def section_of(text, pos):
+    """The section of text holding pos: from the heading before it to the next
+    heading of the same or a higher level (its subsections are in it)."""
+    heads = [(m.start(), len(m.group(1))) for m in HEADING.finditer(text)]
+    before = [h for h in heads if h[0] <= pos]
+    lo, level = before[-1] if before else (0, 0)
+    hi = min([len(text)] + [p for p, lv in heads if p > pos and (level == 0 or lv <= level)])
+    return lo, hi
+
+
+def study_page(study):
+    d = os.path.join(RESULTS, study)
+    for name in ("README.md", "report.md"):
+        if os.path.isfile(os.path.join(d, name)):
+            return os.path.join(d, name)
+    return None
 
 
 def files():
     out = [os.path.join(ROOT, "README.md"), os.path.join(RESULTS, "README.md")]
     out += sorted(glob.glob(os.path.join(ROOT, "docs", "*.md")))
+    out += sorted(p for p in (study_page(d) for d in os.listdir(RESULTS)) if p)
     return [f for f in out if os.path.exists(f)]
+
+
+def page_first_line(path, text):
+    """A study page's first line: the study's status when it is not current."""
+    rel = os.path.relpath(path, RESULTS).split(os.sep)
+    if len(rel) != 2 or study_page(rel[0]) != path:
+        return text, None
+    study = rel[0]
+    if study_state(study)["current"]:
+        return text, None
+    line = f"> <!-- s:{study} -->{status_text(study)}<!-- /n -->\n"
+    first = text.split("\n", 1)[0]
+    if first.startswith(f"> <!-- s:{study} -->"):
+        return text, None
+    return line + "\n" + text, f"{os.path.relpath(path, ROOT)}: its first line does not say the study is kept for history"
+
+
+def check_file(path, text, problems, changed):
+    """text with every marker refilled; problems and changes appended."""
+    count = 0
+    rel = os.path.relpath(path, ROOT)
+
+    def repl(m):
+        nonlocal count
+        count += 1
+        kind, key, old = m.group(1), m.group(2), m.group(3)
+        try:
+            if kind == "s":
+                if key not in os.listdir(RESULTS):
+                    raise Missing(f"no study results/{key}")
+                new, studies = status_text(key), set()
+            else:
+                new, studies = value(key)
+                why = doubts(key, studies)
+                if kind == "n" and why:
+                    problems.append(f"{rel}: {key} = {new}: not a current number ({'; '.join(why)}): quote it as "
+                                    f"history (<!-- h:{key} -->) with its studies' status (<!-- s:STUDY -->) "
+                                    f"in its section, or rerun the study")
+                if kind == "h":
+                    if not why:
+                        problems.append(f"{rel}: {key} = {new} is current: quote it with <!-- n:{key} -->")
+                    lo, hi = section_of(text, m.start())
+                    for st in sorted(studies):
+                        if f"<!-- s:{st} -->" not in text[lo:hi]:
+                            problems.append(f"{rel}: {key} is history from results/{st}, whose status "
+                                            f"(<!-- s:{st} -->) is not in its section")
+        except Missing as e:
+            problems.append(f"{rel}: {key}: {e}")
+            return m.group(0)
+        if new != old:
+            changed.append(f"{rel}: {key}: '{old}' -> '{new}'")
+        return f"<!-- {kind}:{key} -->{new}<!-- /n -->"
+
+    new_text = MARKER.sub(repl, text)
+    new_text, missing_line = page_first_line(path, new_text)
+    if missing_line:
+        changed.append(missing_line)
+    return new_text, count
 
 
 def main(argv):
@@ -528,7 +840,9 @@ def main(argv):
         bad = 0
         for k in NUMBERS:
             try:
-                print(f"{k}: {value(k)}")
+                text, studies = value(k)
+                why = doubts(k, studies)
+                print(f"{k}: {text}" + (f"    [history: {'; '.join(why)}]" if why else ""))
             except Missing as e:
                 print(f"{k}: ERROR {e}")
                 bad = 1
@@ -537,21 +851,8 @@ def main(argv):
     for path in paths:
         with open(path) as f:
             text = f.read()
-
-        def repl(m):
-            nonlocal markers
-            markers += 1
-            key, old = m.group(1), m.group(2)
-            try:
-                new = value(key)
-            except Missing as e:
-                problems.append(f"{os.path.relpath(path, ROOT)}: {key}: {e}")
-                return m.group(0)
-            if new != old:
-                changed.append(f"{os.path.relpath(path, ROOT)}: {key}: '{old}' -> '{new}'")
-            return f"<!-- n:{key} -->{new}<!-- /n -->"
-
-        new_text = MARKER.sub(repl, text)
+        new_text, n = check_file(path, text, problems, changed)
+        markers += n
         if mode == "--write" and new_text != text:
             with open(path, "w") as f:
                 f.write(new_text)

@@ -3,7 +3,8 @@
 
     scripts/study_status.py [--binary PATH] [--json] [STUDY_DIR ...]
 
-For each study folder (default: every results/*/ with a cells.csv), from its
+For each study folder (default: every results/*/ with a cells.csv, or a
+runs.csv of single runs, each row naming its run's folder in "dir"), from its
 cells' run.json files and cells.csv:
 
 - build: the git commits its cells were built from (and whether the tree was
@@ -83,9 +84,24 @@ def current_hashes(specs, binary):
 
 
 def read_cells(study):
+    """cells.csv of a matrix study, else runs.csv of a study of single runs
+    (a row per run, its folder in "dir"; a row whose "load" column is not
+    "idle" ran beside a load on purpose, so its machine_busy is no fault)."""
     path = os.path.join(study, "cells.csv")
+    if not os.path.isfile(path):
+        path = os.path.join(study, "runs.csv")
     with open(path, newline="") as f:
         return list(csv.DictReader(f))
+
+
+def run_json_path(study, cell):
+    if "dir" in cell:
+        return os.path.join(study, cell["dir"], "run.json")
+    return os.path.join(study, "cells", cell["id"], "run.json")
+
+
+def unintended_busy(cell):
+    return cell.get("machine_busy") == "1" and cell.get("load", "idle") == "idle"
 
 
 def status(study, binary=DEFAULT_BINARY):
@@ -94,14 +110,14 @@ def status(study, binary=DEFAULT_BINARY):
     recorded = {}   # spec -> set of hashes its cells ran
     missing = 0
     for c in cells:
-        path = os.path.join(study, "cells", c["id"], "run.json")
+        path = run_json_path(study, c)
         try:
             with open(path) as f:
                 run = json.load(f)
         except (OSError, ValueError):
             missing += 1
             continue
-        recorded.setdefault(cell_spec(c), set()).add(recorded_hash(run))
+        recorded.setdefault(cell_spec(c) if "solver" in c else run["solver"], set()).add(recorded_hash(run))
         prov = run.get("provenance", {})
         build = prov.get("build", {})
         if build.get("git_commit"):
@@ -116,10 +132,11 @@ def status(study, binary=DEFAULT_BINARY):
     now = current_hashes(recorded, binary)
     stale = sorted(s for s, hs in recorded.items() if hs != {now[s]})
     settings = {}
+    measured = {"repeat", "s_per_frame", "machine_busy", "others_cpu_s", "dir"}
     for c in cells:
         key = tuple(v for k, v in sorted(c.items()) if k in
                     ("scene", "solver", "eps", "scale", "threads", "frames_asked", "first_timed_frame", "set",
-                     "solver_opts"))
+                     "solver_opts")) if "id" in c else tuple(v for k, v in sorted(c.items()) if k not in measured)
         settings[key] = settings.get(key, 0) + 1
     return {
         "study": os.path.basename(os.path.normpath(study)),
@@ -131,7 +148,7 @@ def status(study, binary=DEFAULT_BINARY):
         "machines": sorted(cpus),
         "cores": sorted(cores),
         "repeats": max(settings.values()) if settings else 0,
-        "busy_cells": sum(c.get("machine_busy") == "1" for c in cells),
+        "busy_cells": sum(unintended_busy(c) for c in cells),
         "busy_recorded": any("machine_busy" in c for c in cells),
         "stale_solvers": stale,
         "current": not stale,
@@ -142,7 +159,8 @@ def studies(args):
     if args:
         return args
     top = os.path.join(ROOT, "results")
-    return sorted(os.path.join(top, d) for d in os.listdir(top) if os.path.isfile(os.path.join(top, d, "cells.csv")))
+    return sorted(os.path.join(top, d) for d in os.listdir(top)
+                  if any(os.path.isfile(os.path.join(top, d, f)) for f in ("cells.csv", "runs.csv")))
 
 
 def main(argv):

@@ -128,6 +128,41 @@ static int all_digits(const char *s)
     return 1;
 }
 
+/* What a --set path may name where it failed: the keys the object holds, or
+ * the array's index range, for the one-line error. */
+static const char *keys_there(const json_t *cur, const SceneKey *may_add, char *buf, size_t n)
+{
+    if (json_is_array(cur)) {
+        size_t len = json_array_size(cur);
+        if (len) snprintf(buf, n, " (indices 0..%zu)", len - 1);
+        else snprintf(buf, n, " (an empty array)");
+        return buf;
+    }
+    if (!json_is_object(cur)) {
+        snprintf(buf, n, " (its parent is a %s, not an object)", json_is_string(cur) ? "string" : "number or literal");
+        return buf;
+    }
+    size_t used = (size_t)snprintf(buf, n, " (there:");
+    const char *k;
+    json_t *v;
+    int first = 1;
+    json_object_foreach((json_t *)cur, k, v) {
+        if (used >= n) break;
+        used += (size_t)snprintf(buf + used, n - used, "%s %s", first ? "" : ",", k);
+        first = 0;
+    }
+    if (first && used < n) used += (size_t)snprintf(buf + used, n - used, " nothing");
+    first = 1;
+    for (const SceneKey *sk = may_add; sk && sk->name && used < n; ++sk)
+        if (sk->optional && !json_object_get(cur, sk->name)) {
+            used += (size_t)snprintf(buf + used, n - used, "%s %s", first ? "; may be added:" : ",", sk->name);
+            first = 0;
+        }
+    if (used < n) snprintf(buf + used, n - used, ")");
+    if (used >= n && n > 5) strcpy(buf + n - 5, "...)");
+    return buf;
+}
+
 static int apply_override(json_t *root, const char *file, const SceneOverride *o)
 {
     if (!o->key || !o->key[0] || !o->value)
@@ -158,9 +193,10 @@ static int apply_override(json_t *root, const char *file, const SceneOverride *o
             next = json_array_get(cur, (size_t)strtoull(tok[k], NULL, 10));
         char np[512];
         sj_path(np, sizeof np, path, tok[k]);
+        char there[400];
         if (!next)
             return mpm_error(MPM_EINPUT, "%s: --set %s: %s does not exist%s", file, o->key, np,
-                             json_is_array(cur) ? " (array index out of range)" : "");
+                             keys_there(cur, NULL, there, sizeof there));
         strcpy(path, np);
         cur = next;
     }
@@ -188,7 +224,9 @@ static int apply_override(json_t *root, const char *file, const SceneOverride *o
                 keys = scene_source_keys;
             if (!keys || !scene_key_optional(keys, leaf)) {
                 json_decref(val);
-                return mpm_error(MPM_EINPUT, "%s: --set %s: %s does not exist", file, o->key, lp);
+                char there[400];
+                return mpm_error(MPM_EINPUT, "%s: --set %s: %s does not exist%s", file, o->key, lp,
+                                 keys_there(cur, keys, there, sizeof there));
             }
         }
         json_object_set_new(cur, leaf, val);
@@ -202,7 +240,8 @@ static int apply_override(json_t *root, const char *file, const SceneOverride *o
         }
     }
     json_decref(val);
-    return mpm_error(MPM_EINPUT, "%s: --set %s: %s does not exist", file, o->key, lp);
+    char there[400];
+    return mpm_error(MPM_EINPUT, "%s: --set %s: %s does not exist%s", file, o->key, lp, keys_there(cur, NULL, there, sizeof there));
 }
 
 /* ======================================================================

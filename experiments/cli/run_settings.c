@@ -8,6 +8,7 @@
 #include "core/threads.h"
 #include "experiments/accuracy/error_ref.h"
 #include "experiments/driver/registry.h"
+#include "experiments/run/vtk.h"
 #include "solvers/solver.h"
 
 _Static_assert(RUN_MAX_LIST == OPT_LIST_MAX, "RunConfig lists hold OPT_LIST_MAX values");
@@ -55,6 +56,10 @@ const Option run_settings[] = {
      "a ParaView time series of the particles into DIR (particles.pvd over binary VTK XML files, one per frame)"},
     {"--vtk-grid", NULL, NULL, OPT_SWITCH, 0, 0, NULL, NULL, F(vtk_grid), 0, NULL, 0,
      "with --vtk: also the grid series (grid.pvd: active nodes, mass and velocity)"},
+    {"--vtk-grid-min-mass", NULL, "R", OPT_REAL, 0, 1, "a fraction in [0, 1]", NULL, F(vtk_grid_min_mass), 0, NULL, 0,
+     "with --vtk-grid: leave out the nodes lighter than R times the frame's heaviest node (default "
+     OPT_SPELLED(VTK_GRID_MIN_MASS_DEFAULT) "; 0 keeps every node): a node that only the tail of a particle's "
+     "weights reaches carries a velocity far from any particle's"},
     {"--asset-dir", "asset_dir", "DIR", OPT_TEXT, 0, 0, "a directory name", NULL, F(asset_dir), 0, NULL,
      OPT_IN_DEFAULTS | OPT_KEY_DIR, "where a scene's mesh files are (default: beside the scene file)"},
     {"--error-ref", "error_ref", "SOLVER[:EPS]|auto[:EPS]", OPT_TEXT, 0, 0, "a reference solver spec", NULL,

@@ -22,22 +22,46 @@
 
 static const char *const list_what[] = {"solvers", "scenes", "definitions", NULL};
 
-static void print_scene(const char *name, const char *desc, void *ctx)
-{
-    (void)ctx;
-    printf("%-16s %s\n", name, desc);
-}
-
 typedef struct {
     const char *solver[OPT_LIST_MAX]; /* list definitions --solver SPEC: these specs instead of the presets */
     int n_solver;
+    int particles;                    /* list scenes --particles: each scene's particle count */
+    double scale;                     /* at this --scale (0: 1) */
 } ListArgs;
+
+static void print_scene(const char *name, const char *desc, void *ctx)
+{
+    const ListArgs *a = ctx;
+    if (!a->particles) {
+        printf("%-16s %s\n", name, desc);
+        return;
+    }
+    /* the count is what sampling the scene gives; a scene whose meshes are
+     * not installed says so instead of failing the list */
+    SceneLoadOptions opt = {.scale = a->scale > 0 ? a->scale : 1.0};
+    Scene s;
+    if (scene_load(name, &opt, &s) != MPM_OK) {
+        printf("%-20s %12s  (%s)\n", name, "-",
+               strstr(mpm_last_error(), "not found in the asset directory") ? "needs its mesh files: run --asset-dir DIR"
+                                                                             : mpm_last_error());
+        mpm_clear_error();
+        return;
+    }
+    char count[32];
+    snprintf(count, sizeof count, "%zu", s.particles.n);
+    printf("%-20s %12s%s\n", name, count, s.n_sources ? "  (at the start; its sources add more)" : "");
+    scene_free(&s);
+}
 
 static const Option list_options[] = {
     {"--solver", NULL, "SPEC", OPT_LIST, 0, 0, "a solver spec", NULL, offsetof(ListArgs, solver),
      offsetof(ListArgs, n_solver), NULL, 0,
      "with definitions: the definition of this spec (a preset, PRESET:k=v,... or OUTER:INVERSE[:k=v,...]) "
      "instead of every preset's (repeatable)"},
+    {"--particles", NULL, NULL, OPT_SWITCH, 0, 0, NULL, NULL, offsetof(ListArgs, particles), 0, NULL, 0,
+     "with scenes: each scene's particle count at the start instead of its description (samples every scene)"},
+    {"--scale", NULL, "S", OPT_REAL, 0, 0, NULL, NULL, offsetof(ListArgs, scale), 0, NULL, OPT_MIN_OPEN,
+     "with scenes --particles: the counts at this --scale (default 1, the paper's)"},
     {NULL}};
 
 static int list_run(void *args, const char *what, int *exit_code)
@@ -46,6 +70,9 @@ static int list_run(void *args, const char *what, int *exit_code)
     const ListArgs *a = args;
     if (a->n_solver && strcmp(what, "definitions"))
         return mpm_error(MPM_EINPUT, "list %s: --solver is for 'list definitions' only", what);
+    if ((a->particles || a->scale > 0) && strcmp(what, "scenes"))
+        return mpm_error(MPM_EINPUT, "list %s: --particles and --scale are for 'list scenes' only", what);
+    if (a->scale > 0 && !a->particles) return mpm_error(MPM_EINPUT, "list scenes --scale: needs --particles");
     if (!strcmp(what, "solvers")) {
         registry_print(stdout);
         return MPM_OK;
@@ -53,7 +80,8 @@ static int list_run(void *args, const char *what, int *exit_code)
     if (!strcmp(what, "definitions"))
         return a->n_solver ? registry_print_spec_definitions(stdout, a->solver, a->n_solver)
                            : registry_print_definitions(stdout);
-    return scene_list(print_scene, NULL);
+    if (a->particles) printf("%-20s %12s  (at --scale %g)\n", "scene", "particles", a->scale > 0 ? a->scale : 1.0);
+    return scene_list(print_scene, (void *)a);
 }
 
 static const Command list_command = {
@@ -191,6 +219,30 @@ void cli_program_usage(FILE *f)
                "                     as the scenes are)\n");
 }
 
+/* mpmbench GROUP --help ("matrix"): the group's commands, each with its synopsis and summary. */
+static void group_usage(const char *group, FILE *f)
+{
+    size_t len = strlen(group);
+    fprintf(f, "usage: mpmbench %s COMMAND ...    (mpmbench %s COMMAND --help: its options)\n\ncommands:\n", group,
+            group);
+    for (int i = 0; cli_commands[i]; ++i)
+        if (!strncmp(cli_commands[i]->name, group, len) && cli_commands[i]->name[len] == ' ') {
+            fprintf(f, "  ");
+            cli_synopsis(cli_commands[i], f);
+            fprintf(f, "\n      ");
+            cli_wrap(f, 6, 6, cli_commands[i]->summary);
+        }
+}
+
+/* Is word the first word of two-word commands ("matrix")? */
+static int is_group(const char *word)
+{
+    size_t len = strlen(word);
+    for (int i = 0; cli_commands[i]; ++i)
+        if (!strncmp(cli_commands[i]->name, word, len) && cli_commands[i]->name[len] == ' ') return 1;
+    return 0;
+}
+
 static int help_wanted(const char *a) { return !strcmp(a, "--help") || !strcmp(a, "-h") || !strcmp(a, "help"); }
 
 /* The command argv names from argv[1] on ("matrix run" takes two words); *words how many. */
@@ -223,9 +275,9 @@ static const Command *find_command(int argc, char **argv, int *words, int *statu
             len += (size_t)snprintf(choices + len, sizeof choices - len, "%s'%s'", sep, cli_commands[i]->name + strlen(group));
             ++n;
         }
-    if (n && argc > 2 && help_wanted(argv[2])) return NULL; /* mpmbench matrix --help: the program's usage */
+    if (n && argc > 2 && help_wanted(argv[2])) return NULL; /* mpmbench matrix --help: the group's usage */
     if (!n) *status = mpm_error(MPM_EINPUT, "unknown command '%s' (see: mpmbench --help)", argv[1]);
-    else if (argc < 3) *status = mpm_error(MPM_EINPUT, "%s: expected %s (see: mpmbench --help)", argv[1], choices);
+    else if (argc < 3) *status = mpm_error(MPM_EINPUT, "%s: expected %s (see: mpmbench %s --help)", argv[1], choices, argv[1]);
     else *status = mpm_error(MPM_EINPUT, "%s '%s': expected %s", argv[1], argv[2], choices);
     return NULL;
 }
@@ -247,6 +299,10 @@ int cli_main(int argc, char **argv)
         return CLI_EXIT_OK;
     }
     int help_first = help_wanted(argv[1]); /* mpmbench help COMMAND */
+    if (help_first && argc == 3 && is_group(argv[2])) {
+        group_usage(argv[2], stdout); /* mpmbench help matrix */
+        return CLI_EXIT_OK;
+    }
     int first = help_first ? 2 : 1, words = 0, exit_code = CLI_EXIT_OK;
     int st = threads_check_env(); /* before OpenMP reads it at the first parallel region */
     const Command *cmd = st ? NULL : find_command(argc - first + 1, argv + first - 1, &words, &st);
@@ -264,7 +320,7 @@ int cli_main(int argc, char **argv)
         else if (!st) st = cmd->run(args, operand, &exit_code);
         free(args);
     } else if (!st && argc > first + 1 && help_wanted(argv[first + 1])) {
-        cli_program_usage(stdout); /* mpmbench matrix --help */
+        group_usage(argv[first], stdout); /* mpmbench matrix --help */
         return CLI_EXIT_OK;
     }
     if (st) {

@@ -32,7 +32,9 @@ int machine_was_busy(double others_cpu_s, double elapsed_s, int threads, int cor
 {
     if (others_cpu_s < 0 || elapsed_s <= 0 || cores <= 0) return 0;
     int spare = threads > 0 && threads < cores ? cores - threads : 0;
-    return others_cpu_s > elapsed_s * (spare + 0.1);
+    /* /proc/stat counts in clock ticks (10 ms a core): below a few ticks
+     * others' time is the counters' rounding, not load */
+    return others_cpu_s > elapsed_s * (spare + 0.1) && others_cpu_s > MACHINE_LOAD_RESOLUTION_S;
 }
 
 double process_cpu_seconds(void)

@@ -20,7 +20,9 @@ double machine_load1(void);
  * a tenth of a core on average is busy: with OpenMP threads even a small
  * share of a core taken by another process can slow the work many times (a
  * descheduled thread holds up its team at every barrier). Unknown values
- * (< 0) are not busy. */
+ * (< 0), and others' time below MACHINE_LOAD_RESOLUTION_S (the counters'
+ * rounding over a short window), are not busy. */
+#define MACHINE_LOAD_RESOLUTION_S 0.05
 int machine_was_busy(double others_cpu_s, double elapsed_s, int threads, int cores);
 
 /* CPU seconds this process has used (all its threads, user and system). */

@@ -52,7 +52,7 @@ int cell_child_start(char *const *args, int argc, const char *dir, double timeou
      * async-signal-safe calls until execve */
     size_t n_env = 0;
     while (environ[n_env]) n_env++;
-    char **env = malloc(sizeof *env * (n_env + 1));
+    char **env = malloc(sizeof *env * (n_env + 2));
     char **argv = malloc(sizeof *argv * (size_t)(argc + 2));
     int out = open_out(dir, "stdout.txt"), err = open_out(dir, "stderr.txt");
     int in = open("/dev/null", O_RDONLY | O_CLOEXEC);
@@ -67,7 +67,8 @@ int cell_child_start(char *const *args, int argc, const char *dir, double timeou
     if (!st) {
         size_t k = 0;
         for (size_t i = 0; i < n_env; ++i)
-            if (!matrix_is_launcher_env(environ[i])) env[k++] = environ[i];
+            if (!matrix_is_launcher_env(environ[i]) && strncmp(environ[i], "MPM_MATRIX_CELL=", 16)) env[k++] = environ[i];
+        env[k++] = "MPM_MATRIX_CELL=1"; /* run leaves the machine's load to the runner (cells.csv) */
         env[k] = NULL;
         argv[0] = "mpmbench";
         for (int i = 0; i < argc; ++i) argv[i + 1] = args[i];

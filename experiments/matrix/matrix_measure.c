@@ -49,9 +49,9 @@ static int severity(const char *s)
 static double num(const char *s) { return s[0] ? strtod(s, NULL) : 0.0; }
 
 
-/* A frame the run cut short at its time limit: frames.csv complete = 0, or
- * (files written before that column) status timeout for --max-run-seconds. */
-static int frame_cut_short(const CsvTable *t, int r, int c_complete, int c_status, int c_reason)
+/* A frame that did not reach its end: frames.csv complete = 0, or (files
+ * written before that column) status timeout for --max-run-seconds. */
+static int frame_incomplete(const CsvTable *t, int r, int c_complete, int c_status, int c_reason)
 {
     if (c_complete >= 0) return !strcmp(csv_get(t, r, c_complete), "0");
     return c_reason >= 0 && !strcmp(csv_get(t, r, c_status), "timeout") &&
@@ -82,8 +82,11 @@ void cell_measure(const char *dir, int first_timed_frame, CellMeasure *m)
             }
             if (res > m->max_residual) m->max_residual = res;
             m->wall_s += wall;
-            if (frame_cut_short(&t, r, c_complete, c_status, c_reason)) {
-                m->cut_short = 1; /* its time is in wall_s only: not a frame */
+            if (frame_incomplete(&t, r, c_complete, c_status, c_reason)) {
+                /* its time is in wall_s only: not a frame. Only the time
+                 * limit cuts a run short; a frame a failed step ended is the
+                 * run's result (worst_solve_status failed), not a limit */
+                if (!strcmp(s, "timeout")) m->cut_short = 1;
                 continue;
             }
             m->frames++;

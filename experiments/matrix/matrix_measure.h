@@ -47,7 +47,8 @@ typedef struct {
  * a timeout) give what was written before. A frame the run cut short at its
  * --max-run-seconds (frames.csv complete = 0; in older files: status
  * timeout with the run limit as its reason) is not a frame: it counts in
- * wall_s only. Never fails. */
+ * wall_s only; so is a frame a failed step ended (frames.csv complete = 0,
+ * status failed), which does not make the cell cut short. Never fails. */
 void cell_measure(const char *dir, int first_timed_frame, CellMeasure *m);
 
 /* The status of a child from its wait status (timed_out: the runner killed it). */

@@ -92,8 +92,20 @@ static int write_json(const char *path, json_t *j)
 }
 
 /* DIR/matrix.json (what the report needs) and DIR/provenance.json (one entry per invocation). */
-static int write_metadata(Run *r, int ranks, int jobs)
+/* The options of this invocation as given, so it can be run again
+ * (scripts/reproduce.sh). */
+static json_t *options_json(const MatrixRunOptions *o)
 {
+    json_t *only = json_array();
+    for (int i = 0; i < o->n_only; ++i) json_array_append_new(only, json_string(o->only[i]));
+    return json_pack("{s:o, s:i, s:o, s:o, s:b}", "only", only, "jobs", o->jobs,
+                     "threads", o->threads > 0 ? json_integer(o->threads) : json_null(), "asset_dir",
+                     o->asset_dir ? json_string(o->asset_dir) : json_null(), "check", o->check);
+}
+
+static int write_metadata(Run *r, int ranks, const MatrixRunOptions *o)
+{
+    int jobs = o->jobs;
     char path[1200];
     snprintf(path, sizeof path, "%s/matrix.json", r->dir);
     json_t *meta = json_pack("{s:s, s:s, s:s, s:s, s:o, s:b, s:O}", "name", r->m.name, "description", r->m.description,
@@ -112,6 +124,7 @@ static int write_metadata(Run *r, int ranks, int jobs)
         json_object_set_new(p, "ranks", json_integer(ranks));
         json_object_set_new(p, "jobs_per_rank", json_integer(jobs));
         json_object_set_new(p, "cells_to_run", json_integer(r->n_todo));
+        json_object_set_new(p, "options", options_json(o));
         json_array_append_new(json_object_get(all, "invocations"), p);
     }
     return write_json(path, all);
@@ -360,7 +373,7 @@ static int prepare(Run *r, const char *file, const MatrixRunOptions *o, int use_
     if ((st = paths_mkdir_p(cells_dir))) return st;
     if ((st = cells_file_open(r->dir, header, 1, fill_column, r, &r->results))) return st;
     if (use_mpi && ranks > 1) order_by_estimate(r);
-    if ((st = write_metadata(r, ranks, o->jobs))) return st;
+    if ((st = write_metadata(r, ranks, o))) return st;
     printf("matrix %s: %d cells, %d done already, %d to run on %d rank%s x %d job%s; results in %s/cells.csv\n",
            r->m.name, r->cells.n, r->n_done_before, r->n_todo, ranks, ranks > 1 ? "s" : "", o->jobs,
            o->jobs > 1 ? "s" : "", r->dir);

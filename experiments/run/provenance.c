@@ -142,9 +142,10 @@ json_t *provenance_json(int threads, int with_checkout)
     if (libs) json_object_set_new(libs, "openblas", json_string(openblas));
     if (libs) json_object_set_new(libs, "mpi", json_string(mpi));
     if (libs) json_object_set_new(libs, "jansson", json_string(jansson));
-    json_t *envs = json_pack("{s:s, s:s, s:s, s:s}", "OMP_WAIT_POLICY", env_or_empty("OMP_WAIT_POLICY"),
-                             "OMP_NUM_THREADS", env_or_empty("OMP_NUM_THREADS"), "OMP_PROC_BIND",
-                             env_or_empty("OMP_PROC_BIND"), "OMP_PLACES", env_or_empty("OMP_PLACES"));
+    json_t *envs = json_pack("{s:s, s:s, s:s, s:s, s:s}", "OMP_WAIT_POLICY", env_or_empty("OMP_WAIT_POLICY"),
+                             "GOMP_SPINCOUNT", env_or_empty("GOMP_SPINCOUNT"), "OMP_NUM_THREADS",
+                             env_or_empty("OMP_NUM_THREADS"), "OMP_PROC_BIND", env_or_empty("OMP_PROC_BIND"),
+                             "OMP_PLACES", env_or_empty("OMP_PLACES"));
     if (self) dlclose(self);
     json_t *p = json_pack("{s:o, s:s, s:s, s:s, s:i, s:i, s:i, s:o, s:o, s:s}", "build", build, "host", host, "os", os,
                           "cpu_model", model, "cores_online", (int)sysconf(_SC_NPROCESSORS_ONLN), "physical_cores",

@@ -34,6 +34,7 @@ void run_config_default(RunConfig *c)
     memset(c, 0, sizeof *c);
     c->eps = SOLVE_EPS_DEFAULT;
     c->scale = 1.0;
+    c->vtk_grid_min_mass = VTK_GRID_MIN_MASS_DEFAULT;
 }
 
 void run_solve_settings(const RunConfig *cfg, SolveSettings *set)
@@ -196,6 +197,8 @@ int run_config_check(const RunConfig *cfg)
     if ((st = paths_check_output_dir("--particles", cfg->particles_dir))) return st;
     if ((st = paths_check_output_dir("--vtk", cfg->vtk_dir))) return st;
     if (cfg->vtk_grid && !cfg->vtk_dir) return mpm_error(MPM_EINPUT, "--vtk-grid: needs --vtk DIR");
+    if (cfg->vtk_grid_min_mass != VTK_GRID_MIN_MASS_DEFAULT && !cfg->vtk_grid)
+        return mpm_error(MPM_EINPUT, "--vtk-grid-min-mass %g: needs --vtk-grid", cfg->vtk_grid_min_mass);
     AccuracyConfig acc = accuracy_config(cfg);
     if ((st = run_accuracy_check(&acc))) return st;
     if (cfg->checkpoint_at && (st = run_check_frame_list(cfg->checkpoint_at))) return st;
@@ -429,7 +432,7 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     memset(&vtk, 0, sizeof vtk);
     if ((status = paths_mkdir_p(out_dir))) goto done;
     if (cfg->particles_dir && (status = paths_mkdir_p(cfg->particles_dir))) goto done;
-    if (cfg->vtk_dir && (status = vtk_series_open(&vtk, cfg->vtk_dir, cfg->vtk_grid))) goto done;
+    if (cfg->vtk_dir && (status = vtk_series_open(&vtk, cfg->vtk_dir, cfg->vtk_grid, cfg->vtk_grid_min_mass))) goto done;
     if (!(steps_csv = open_in(out_dir, "steps.csv", &status))) goto done;
     if (!(frames_csv = open_in(out_dir, "frames.csv", &status))) goto done;
     if (cfg->history && !(iters_csv = open_in(out_dir, "iters.csv", &status))) goto done;
@@ -488,7 +491,8 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
                tot->frames ? tot->wall_s / tot->frames : 0.0, solve_status_name((SolveStatus)tot->worst_status));
         printf("wrote %s/steps.csv and %s/frames.csv%s\n", out_dir, out_dir, iters_csv ? " and iters.csv" : "");
     }
-    if (load.busy)
+    /* a matrix cell's load is the runner's to report (cells.csv machine_busy) */
+    if (load.busy && !getenv("MPM_MATRIX_CELL"))
         fprintf(stderr,
                 "mpmbench: warning: other processes used %.1f CPU-seconds of the run's %.1f s on %d cores while it "
                 "ran on %d thread%s: its times are not valid (machine_load in run.json; on a shared machine "

@@ -33,6 +33,7 @@ typedef struct {
     const char *particles_dir;  /* PLY per frame when set */
     const char *vtk_dir;        /* ParaView series (experiments/run/vtk.h) when set */
     int vtk_grid;               /* with vtk_dir: also the grid series */
+    double vtk_grid_min_mass;   /* grid nodes lighter than this times the frame's heaviest are left out */
     const char *asset_dir;
     int armijo;                 /* the same as solver option linesearch=armijo */
     int quiet;                  /* no per-frame table */

@@ -10,12 +10,13 @@
 #include "core/fcr.h"
 #include "experiments/io/paths.h"
 
-int vtk_series_open(VtkSeries *s, const char *dir, int grid)
+int vtk_series_open(VtkSeries *s, const char *dir, int grid, double min_mass)
 {
     memset(s, 0, sizeof *s);
     if (snprintf(s->dir, sizeof s->dir, "%s", dir) >= (int)sizeof s->dir)
         return mpm_error(MPM_EINPUT, "--vtk '%s': path too long", dir);
     s->grid = grid;
+    s->min_mass = min_mass;
     return paths_mkdir_p(dir);
 }
 
@@ -209,20 +210,30 @@ static int particles_file(VtkSeries *s, int frame, const Particles *p, const Mat
 static int grid_file(VtkSeries *s, int frame, const Grid *g, const double *grid_v)
 {
     size_t n = (size_t)g->n;
-    float *buf = malloc(sizeof *buf * (7 * n + 1));
+    float *buf = malloc(sizeof *buf * (10 * n + 1));
     if (!buf) return mpm_error(MPM_EINTERNAL, "out of memory (%zu grid nodes)", n);
-    float *x = buf, *v = buf + 3 * n, *m = buf + 6 * n;
+    float *x = buf, *v = buf + 3 * n, *m = buf + 6 * n, *q = buf + 7 * n;
+    double heaviest = 0.0;
+    for (size_t k = 0; k < n; ++k)
+        if (g->mass[k] > heaviest) heaviest = g->mass[k];
+    double floor_mass = s->min_mass * heaviest;
+    size_t kept = 0;
     for (size_t k = 0; k < n; ++k) {
+        if (s->min_mass > 0 && g->mass[k] < floor_mass) continue;
         for (int d = 0; d < 3; ++d) {
-            x[3 * k + d] = (float)(g->coord[3 * k + d] * g->dx);
-            v[3 * k + d] = (float)grid_v[3 * k + d];
+            x[3 * kept + d] = (float)(g->coord[3 * k + d] * g->dx);
+            v[3 * kept + d] = (float)grid_v[3 * k + d];
+            q[3 * kept + d] = (float)(g->mass[k] * grid_v[3 * k + d]);
         }
-        m[k] = (float)g->mass[k];
+        m[kept++] = (float)g->mass[k];
     }
-    VtkArray data[] = {{"mass", "Float32", 1, m, sizeof(float) * n}, {"velocity", "Float32", 3, v, sizeof(float) * 3 * n}};
+    n = kept;
+    VtkArray data[] = {{"mass", "Float32", 1, m, sizeof(float) * n},
+                       {"velocity", "Float32", 3, v, sizeof(float) * 3 * n},
+                       {"momentum", "Float32", 3, q, sizeof(float) * 3 * n}};
     char path[1200];
     snprintf(path, sizeof path, "%s/grid_%04d.vtp", s->dir, frame);
-    int st = write_vtp(path, n, x, data, 2);
+    int st = write_vtp(path, n, x, data, (int)(sizeof data / sizeof data[0]));
     free(buf);
     return st;
 }

@@ -10,6 +10,15 @@ check "list solvers has pn-pcg-mf" grep -q "^pn-pcg-mf " "$tmp/solvers"
 check "list solvers has pn-sgs-pcg" grep -q "^pn-sgs-pcg " "$tmp/solvers"
 "$bin" list scenes >"$tmp/scenes"
 for s in drop bar3 stretched-box; do check "list scenes has $s" grep -q "^$s " "$tmp/scenes"; done
+# list scenes --particles: the count a run of the scene starts with
+"$bin" list scenes --particles --scale 4 >"$tmp/counts"
+check "list scenes --particles: exit 0" test $? -eq 0
+check "list scenes --particles: one row per scene and a header" test "$(wc -l <"$tmp/counts")" -eq "$(($(wc -l <"$tmp/scenes") + 1))"
+"$bin" run --scene stretched-box --scale 4 --solver pn-pcg --frames 1 --quiet --out "$tmp/count-run" >/dev/null 2>&1
+want_n=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['particles'])" "$tmp/count-run/run.json")
+check "list scenes --particles: stretched-box's count is the run's ($want_n)" grep -qE "^stretched-box +$want_n\$" "$tmp/counts"
+check "list scenes --particles: a source scene says more come" grep -qE "^sauce +[0-9]+  \(at the start; its sources add more\)" "$tmp/counts"
+expect_input_error "list scenes --scale: needs --particles" list scenes --scale 3
 
 # a short run writes the three CSV files with the documented headers
 "$bin" run --scene drop --solver pn-pcg --frames 1 --out "$tmp/run" --history --quiet

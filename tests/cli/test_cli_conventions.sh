@@ -38,6 +38,13 @@ for c in "${commands[@]}"; do
 done
 "$bin" matrix --help >"$tmp/matrix-help.txt"
 check "'matrix --help': exit 0" test $? -eq 0
+check "'matrix --help' is the group's usage, not the program's" grep -q "^usage: mpmbench matrix COMMAND" "$tmp/matrix-help.txt"
+for sub in run report schema; do
+  check "'matrix --help' names 'matrix $sub'" grep -q "^  mpmbench matrix $sub" "$tmp/matrix-help.txt"
+done
+check "'matrix --help' lists no other command" test "$(grep -c '^  mpmbench ' "$tmp/matrix-help.txt")" -eq 3
+"$bin" help matrix >"$tmp/help-matrix.txt"
+check "'help matrix' = 'matrix --help'" cmp -s "$tmp/matrix-help.txt" "$tmp/help-matrix.txt"
 
 # run --help names every flag of the run settings table (read from its source)
 "$bin" run --help >"$tmp/run-help.txt"
@@ -63,9 +70,20 @@ check "--flag value: exit 0" test $? -eq 0
 check "--flag=value: exit 0" test $? -eq 0
 counts() { cut -d, -f1-14,22-23 "$1"; } # every column but the timings
 check "--flag=value: the same steps.csv" test "$(counts "$tmp/spaced/steps.csv")" = "$(counts "$tmp/joined/steps.csv")"
-check "--flag=value: the same settings in run.json" \
-  test "$(grep -v '"\(start_time\|startup_s\)"' "$tmp/spaced/run.json" | sed 's/spaced/X/')" = \
-  "$(grep -v '"\(start_time\|startup_s\)"' "$tmp/joined/run.json" | sed 's/joined/X/')"
+# settings only: not the times, the machine's load or the output folder's name
+settings() {
+  python3 - "$1" <<'PY'
+import json, sys
+def strip(v):
+    if isinstance(v, dict):
+        return {k: strip(x) for k, x in v.items() if k not in ("start_time", "startup_s", "machine_load")}
+    if isinstance(v, list):
+        return [strip(x) for x in v]
+    return v.replace("spaced", "X").replace("joined", "X") if isinstance(v, str) else v
+print(json.dumps(strip(json.load(open(sys.argv[1]))), sort_keys=True))
+PY
+}
+check "--flag=value: the same settings in run.json" test "$(settings "$tmp/spaced/run.json")" = "$(settings "$tmp/joined/run.json")"
 check "the options reached the run" grep -q '"forcing": "gast"' "$tmp/joined/run.json"
 
 # bad input: one line, exit 2, naming the flag and the value

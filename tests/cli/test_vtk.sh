@@ -7,13 +7,19 @@
 # (--particles, float32 both), id is a permutation, J lies in the range the
 # initial F allows at frame 0, von Mises is positive where F is not a
 # rotation, plastic_J is 1 for an elastic material; grid.pvd has frames
-# 1..N and the nodal masses add up to the particles' mass (P2G conserves it).
+# 1..N; with --vtk-grid-min-mass 0 every node is written and the nodal
+# masses add up to the particles' mass (P2G conserves it); by default the
+# nodes under 1e-3 of the heaviest are left out (this scene has some, with
+# velocities far above any particle's), the rest are those of the full file.
 . "$(dirname "$0")/../common/shell_harness.sh"
 py=${MPM_PYTHON:-/usr/bin/python3}
 "$py" -c "import vtk" 2>/dev/null || skip "$py has no vtk module (Debian: python3-vtk9; scripts/test.sh installs it)"
 "$bin" run --scene stretched-box --solver pn-pcg --scale 5 --frames 2 --quiet --out "$tmp/run" \
   --set objects.0.initial_F.per_particle=true --particles "$tmp/ply" --vtk "$tmp/vtk" --vtk-grid 2>"$tmp/err"
 check "run --vtk exit 0 ($(head -c 200 "$tmp/err"))" test $? -eq 0
+"$bin" run --scene stretched-box --solver pn-pcg --scale 5 --frames 2 --quiet --out "$tmp/run0" \
+  --set objects.0.initial_F.per_particle=true --vtk "$tmp/vtk0" --vtk-grid --vtk-grid-min-mass 0 2>"$tmp/err0"
+check "run --vtk-grid-min-mass 0: exit 0 ($(head -c 200 "$tmp/err0"))" test $? -eq 0
 check "the files" test -s "$tmp/vtk/particles.pvd" -a -s "$tmp/vtk/particles_0000.vtp" -a -s "$tmp/vtk/particles_0002.vtp" \
   -a -s "$tmp/vtk/grid.pvd" -a -s "$tmp/vtk/grid_0001.vtp" -a ! -e "$tmp/vtk/grid_0000.vtp"
 "$py" - "$tmp" >"$tmp/check.txt" 2>&1 <<'PY'
@@ -74,13 +80,24 @@ for k in range(3):
 gsets = ET.parse(f"{tmp}/vtk/grid.pvd").getroot().findall("./Collection/DataSet")
 want([d.get("file") for d in gsets] == ["grid_0001.vtp", "grid_0002.vtp"], "grid pvd: frames 1 and 2")
 for k in (1, 2):
+    out0, x0, a0 = read(f"{tmp}/vtk0/grid_{k:04d}.vtp")
+    gm = float(np.sum(a0["mass"], dtype=np.float64))
+    want(abs(gm - mass) <= 1e-5 * mass, f"grid {k} (every node): nodal mass {gm} = particle mass {mass}")
+    want(np.allclose(a0["momentum"], a0["mass"][:, None] * a0["velocity"], rtol=1e-5, atol=1e-12), "momentum = mass x velocity")
     out, x, a = read(f"{tmp}/vtk/grid_{k:04d}.vtp")
-    gm = float(np.sum(a["mass"], dtype=np.float64))
-    want(abs(gm - mass) <= 1e-5 * mass, f"grid {k}: nodal mass {gm} = particle mass {mass}")
+    light = a0["mass"] < 1e-3 * a0["mass"].max()
+    want(light.any(), f"grid {k}: the scene has nodes under 1e-3 of the heaviest")
+    want(out.GetNumberOfPoints() == out0.GetNumberOfPoints() - int(light.sum()),
+         f"grid {k}: the default leaves out exactly those ({out.GetNumberOfPoints()} of {out0.GetNumberOfPoints()}, {int(light.sum())} light)")
+    want(np.all(a["mass"] >= 1e-3 * a0["mass"].max()), f"grid {k}: no light node kept")
+    want(np.array_equal(x, x0[~light]) and np.array_equal(a["velocity"], a0["velocity"][~light]),
+         f"grid {k}: the kept nodes are the full file's, in order")
     want(a["velocity"].shape == (out.GetNumberOfPoints(), 3), "grid velocity: 3 per node")
     want(np.allclose(x / 0.05, np.round(x / 0.05), atol=1e-4), "grid nodes at multiples of dx")
 print("ok" if not fails else "; ".join(fails))
 PY
 check "read back with VTK ($(head -c 600 "$tmp/check.txt"))" grep -qx ok "$tmp/check.txt"
+expect_input_error "--vtk-grid-min-mass 0.5: needs --vtk-grid" run --scene drop --solver pn-pcg --frames 1 --quiet --out "$tmp/x" --vtk "$tmp/y" --vtk-grid-min-mass 0.5
+expect_input_error "--vtk-grid-min-mass '2'" run --scene drop --solver pn-pcg --frames 1 --quiet --out "$tmp/x" --vtk "$tmp/y" --vtk-grid --vtk-grid-min-mass 2
 expect_input_error "--vtk-grid: needs --vtk DIR" run --scene drop --solver pn-pcg --frames 1 --quiet --out "$tmp/x" --vtk-grid
 finish

@@ -130,11 +130,14 @@ static void test_outcome(void)
     CHECK(!machine_was_busy(2.19, 2.0, 1, 2) && machine_was_busy(2.21, 2.0, 1, 2), "1 thread on 2 cores: the free core may be used");
     CHECK(machine_was_busy(0.3, 2.0, 0, 2) && !machine_was_busy(-1.0, 2.0, 2, 2) && !machine_was_busy(5.0, 0.0, 2, 2),
           "threads unknown: no core free; unknown load or no time: not busy");
+    CHECK(!machine_was_busy(0.04, 0.01, 2, 2) && machine_was_busy(0.06, 0.01, 2, 2),
+          "a short window: others' time under the counters' resolution is not busy");
 }
 
 /* cell_measure on a hand-made cell directory: a frame the run's time limit
  * cut short (complete 0, or in files older than that column, status timeout
- * with the run limit as its reason) is not a frame. */
+ * with the run limit as its reason) is not a frame; a frame a failure ended
+ * is not one either, but the cell was not cut short by a limit. */
 static void test_measure_cut_short(void)
 {
     char dir[300], path[400];
@@ -160,6 +163,15 @@ static void test_measure_cut_short(void)
     fclose(f);
     cell_measure(dir, 0, &m);
     CHECK(m.frames == 1 && m.timed_wall_s == 1.0 && m.cut_short, "old format: step limit is a frame, run limit is not");
+    f = fopen(path, "w"); /* a step failed in frame 1 and the run stopped: not a time limit */
+    fprintf(f, "frame,steps,outer_iters,linear_iters,wall_s,max_residual,status,complete,reason\n"
+               "0,2,4,8,1.0,1e-8,converged,1,\"\"\n"
+               "1,1,3,40,0.5,1e+2,failed,0,\"pcg: r^T M^-1 r = -6.08 (preconditioner not SPD?)\"\n");
+    fclose(f);
+    cell_measure(dir, 0, &m);
+    CHECK(m.frames == 1 && !m.cut_short && !strcmp(m.worst_solve_status, "failed"),
+          "a failed frame is not cut short by the time limit: frames %d cut_short %d worst %s", m.frames, m.cut_short,
+          m.worst_solve_status);
 }
 
 static void test_launcher_env(void)

@@ -337,7 +337,7 @@ static void test_bad_input(void)
 
     SceneOverride o1[1] = {{"materials.sof.E", "1e9"}};
     SceneLoadOptions opt1 = {.overrides = o1, .n_overrides = 1};
-    expect_bad("--set missing path", NULL, NULL, &opt1, "materials.sof", "does not exist");
+    expect_bad("--set missing path", NULL, NULL, &opt1, "materials.sof does not exist", "(there: soft");
     SceneOverride o2[1] = {{"materials.soft.E", "-3"}};
     SceneLoadOptions opt2 = {.overrides = o2, .n_overrides = 1};
     expect_bad("--set bad value", NULL, NULL, &opt2, "materials.soft.E: expected a positive number", "-3");
@@ -346,10 +346,10 @@ static void test_bad_input(void)
     expect_bad("--set overflow", NULL, NULL, &opt3, "dx: expected a number", "1e400");
     SceneOverride o4[1] = {{"objects.3.ppc", "4"}};
     SceneLoadOptions opt4 = {.overrides = o4, .n_overrides = 1};
-    expect_bad("--set index range", NULL, NULL, &opt4, "objects.3", "does not exist");
+    expect_bad("--set index range", NULL, NULL, &opt4, "objects.3 does not exist", "(indices 0..");
     SceneOverride o5[1] = {{"materials.soft.Young", "4"}};
     SceneLoadOptions opt5 = {.overrides = o5, .n_overrides = 1};
-    expect_bad("--set unknown leaf", NULL, NULL, &opt5, "materials.soft.Young", "does not exist");
+    expect_bad("--set unknown leaf", NULL, NULL, &opt5, "materials.soft.Young does not exist (there: ", "; may be added: ");
     SceneLoadOptions opt6 = {.scale = -1};
     expect_bad("negative scale", NULL, NULL, &opt6, "scale", NULL);
 

@@ -1,0 +1,87 @@
+#!/usr/bin/env bash
+# Regenerates a committed study and the numbers the documentation quotes
+# from it, with one command:
+#
+#   scripts/reproduce.sh NAME [--dry-run]
+#
+# NAME is a folder of results/ made by `matrix run`. The script says how
+# long the committed run took (the sum of its cells' elapsed time, on the
+# machine its status line names), then runs the study's matrix file with the
+# options its last invocation recorded (provenance.json "options"; the
+# studies made differently, listed in results/README.md, with theirs) into
+# results/NAME.new, writes its report, replaces results/NAME with it, and
+# refills the quoted numbers (scripts/fill_numbers.py) and the study's
+# status. The new study is current for this build; the old one stays in git.
+#
+# Environment: MPMBENCH, the program (default build-native/mpmbench, a build
+# for this machine: cmake -S . -B build-native -DMPM_NATIVE=ON). Run it on an
+# otherwise idle machine: every cell records the machine's load, and cells
+# run beside other work are flagged busy and cannot be quoted.
+set -euo pipefail
+set -f # the --only globs go to mpmbench as they are
+cd "$(dirname "$0")/.."
+usage() { echo "usage: scripts/reproduce.sh NAME [--dry-run]   (NAME: a folder of results/ with a matrix.json)" >&2; exit 2; }
+[ $# -ge 1 ] || usage
+name=$1
+dry=${2:-}
+[ -z "$dry" ] || [ "$dry" = --dry-run ] || usage
+dir=results/$name
+bin=${MPMBENCH:-build-native/mpmbench}
+[ -f "$dir/matrix.json" ] || { echo "reproduce.sh: $dir has no matrix.json: not a matrix study (see its README)" >&2; exit 2; }
+[ -x "$bin" ] || { echo "reproduce.sh: $bin is not built (cmake -S . -B build-native -DMPM_NATIVE=ON && cmake --build build-native, or set MPMBENCH)" >&2; exit 2; }
+
+# the matrix file and the options of the last invocation
+read -r file args < <(python3 - "$dir" <<'PY'
+import json, os, shlex, sys
+d = sys.argv[1]
+m = json.load(open(os.path.join(d, "matrix.json")))
+f = m["file"] if os.path.isfile(m["file"]) else os.path.join("experiments/matrices", os.path.basename(m["file"]))
+inv = json.load(open(os.path.join(d, "provenance.json")))["invocations"]
+o = next((i["options"] for i in reversed(inv) if "options" in i), None)
+args = []
+if o:
+    for g in o["only"]:
+        args += ["--only", g]
+    if o["threads"]:
+        args += ["--threads", str(o["threads"])]
+    if o["asset_dir"]:
+        args += ["--asset-dir", o["asset_dir"]]
+    if o["check"]:
+        args += ["--check"]
+print(f, " ".join(shlex.quote(a) for a in args))
+PY
+)
+launcher=()
+case $name in # studies made differently (results/README.md), recorded before provenance.json kept options
+  stress) [ -n "$args" ] || args="--check" ;;
+  scenes-mpi2x1)
+    launcher=(mpirun --allow-run-as-root -np 2 --bind-to core)
+    [ -n "$args" ] || args="--threads 1 --only twist/* --only armacat-*/* --only chain/* --only faceless/* --only sauce/* --only bar3/* --only stretched-box/* --only drop/*" ;;
+  foundation) [ -z "$dry" ] && { MPMBENCH=$bin scripts/bench_foundation.sh; exec python3 scripts/fill_numbers.py; } ;;
+esac
+
+python3 - "$dir" <<'PY'
+import csv, json, os, sys
+d = sys.argv[1]
+rows = list(csv.DictReader(open(os.path.join(d, "cells.csv"))))
+secs = sum(float(r.get("elapsed_s") or 0) for r in rows)
+inv = json.load(open(os.path.join(d, "provenance.json")))["invocations"]
+cpu = inv[-1].get("cpu_model", "?") if inv else "?"
+print(f"reproduce.sh: {os.path.basename(d)}: {len(rows)} cells; the committed run's cells took {secs / 60:.0f} min "
+      f"together on {cpu} (the ranks and jobs of its invocation run them side by side)")
+PY
+# shellcheck disable=SC2086
+echo "reproduce.sh: ${launcher[*]:-} $bin matrix run $file $args --out $dir.new"
+[ -z "$dry" ] || exit 0
+load=$(cut -d' ' -f1 /proc/loadavg)
+echo "reproduce.sh: load average now $load on $(nproc) cores (run alone on the machine)"
+rm -rf "$dir.new"
+start=$(date +%s)
+# shellcheck disable=SC2086
+"${launcher[@]}" "$bin" matrix run "$file" $args --out "$dir.new"
+"$bin" matrix report "$dir.new"
+rm -rf "$dir"
+mv "$dir.new" "$dir"
+python3 scripts/fill_numbers.py
+MPM_BINARY=$bin python3 scripts/study_status.py --binary "$bin" "$dir"
+echo "reproduce.sh: $name regenerated in $(( ($(date +%s) - start) / 60 )) min; review and commit results/$name and the refilled pages"
