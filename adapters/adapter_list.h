@@ -15,6 +15,7 @@
 #define MPM_ADAPTERS(X)                                                                     \
     X(boomeramg, MPM_WITH_HYPRE, "libhypre-dev", "hypre", "hypre BoomerAMG")               \
     X(cholmod, MPM_WITH_CHOLMOD, "libsuitesparse-dev", "cholmod", "CHOLMOD")               \
-    X(ml, MPM_WITH_ML, "libtrilinos-ml-dev", "trilinos_ml", "Trilinos ML")
+    X(ml, MPM_WITH_ML, "libtrilinos-ml-dev", "trilinos_ml", "Trilinos ML")                 \
+    X(petsc, MPM_WITH_PETSC, "libpetsc-real3.18-dev", "petsc", "PETSc")
 
 #endif

@@ -1,7 +1,7 @@
 # Finds every third-party dependency, says which Debian package provides a
 # missing one, and gives each an imported target that the floor using it
 # links PRIVATE (docs/design.md, floors). The adapters' libraries (hypre,
-# CHOLMOD, Trilinos ML; adapters/adapter_list.h) are optional: each adapter's
+# CHOLMOD, Trilinos ML, PETSc; adapters/adapter_list.h) are optional: each adapter's
 # option (MPM_WITH_HYPRE, ...) is ON when its library is found.
 
 function(mpm_require found what package)
@@ -80,6 +80,29 @@ if(ML_INCLUDE_DIR AND ML_LIBRARY)
   set(MPM_ADAPTER_ml_FOUND ON)
 endif()
 set(MPM_ADAPTER_ml_LIBS MPM::ml MPI::MPI_C OpenMP::OpenMP_C)
+
+# PETSc (Debian's libpetsc-real3.18-dev: real scalars, 32-bit PetscInt, built
+# with MPI): its pkg-config file first, else its headers and library where
+# Debian puts them (PETSC_DIR/PETSC_ARCH, /usr/lib/petsc).
+find_package(PkgConfig QUIET)
+if(PKG_CONFIG_FOUND)
+  pkg_check_modules(PETSC QUIET PETSc)
+endif()
+set(MPM_ADAPTER_petsc_FOUND OFF)
+if(PETSC_FOUND)
+  mpm_library(MPM::petsc "${PETSC_INCLUDE_DIRS}" "${PETSC_LINK_LIBRARIES}")
+  set(MPM_ADAPTER_petsc_FOUND ON)
+else()
+  find_path(PETSC_INCLUDE_DIR petscksp.h HINTS $ENV{PETSC_DIR}/$ENV{PETSC_ARCH}/include $ENV{PETSC_DIR}/include
+            /usr/lib/petsc/include)
+  find_library(PETSC_LIBRARY NAMES petsc_real petsc HINTS $ENV{PETSC_DIR}/$ENV{PETSC_ARCH}/lib $ENV{PETSC_DIR}/lib
+               /usr/lib/petsc/lib)
+  if(PETSC_INCLUDE_DIR AND PETSC_LIBRARY)
+    mpm_library(MPM::petsc ${PETSC_INCLUDE_DIR} ${PETSC_LIBRARY})
+    set(MPM_ADAPTER_petsc_FOUND ON)
+  endif()
+endif()
+set(MPM_ADAPTER_petsc_LIBS MPM::petsc MPI::MPI_C OpenMP::OpenMP_C)
 
 set(MPM_ADAPTERS "")
 file(STRINGS ${CMAKE_CURRENT_SOURCE_DIR}/adapters/adapter_list.h mpm_adapter_lines REGEX "^ *X\\(")

@@ -18,7 +18,7 @@ if [ "${1:-}" = --with-tests ]; then with_tests=1; shift; fi
 # BLAS CHOLMOD runs on); what only testing needs is installed by
 # scripts/test.sh
 packages=(build-essential cmake python3 python3-matplotlib libhypre-dev libtrilinos-ml-dev libsuitesparse-dev
-          libopenmpi-dev openmpi-bin libjansson-dev libpng-dev libopenblas0)
+          libpetsc-real3.18-dev libopenmpi-dev openmpi-bin libjansson-dev libpng-dev libopenblas0)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

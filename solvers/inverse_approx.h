@@ -69,6 +69,7 @@ typedef struct {
  * (AMG levels and operator complexity, factor nonzeros, ...). */
 #define INV_VIEW_MAX_LEVELS 16
 #define INV_VIEW_MAX_STATS 16
+#define INV_VIEW_TEXT 16384
 typedef struct {
     int nodes;
     int64_t blocks;
@@ -83,6 +84,9 @@ typedef struct {
         char key[32];
         double value;
     } stat[INV_VIEW_MAX_STATS];
+    /* the library's own description of the last setup, the effective
+     * options it ran with (PETSc's KSPView), for run.json; "" = none */
+    char library_view[INV_VIEW_TEXT];
 } InvView;
 /* Appends a named statistic (ignored once the table is full). */
 void inv_view_add(InvView *v, const char *key, double value);

@@ -19,7 +19,7 @@ static uint64_t fnv1a64(const char *s)
 int solver_definition(const Solver *s, char *text, size_t cap, char hash[SOLVER_DEFINITION_HASH_LEN])
 {
     const SolverOptions *o = &s->opts;
-    int order[SOLVER_MAX_OPTS]; /* the asked keys' rows, sorted by key (insertion: at most 32) */
+    int order[SOLVER_MAX_OPTS]; /* the asked keys' rows, sorted by key (insertion: at most SOLVER_MAX_OPTS) */
     for (int i = 0; i < o->n_asked; ++i) {
         int j = i;
         for (; j > 0 && strcmp(o->asked[order[j - 1]], o->asked[i]) > 0; --j) order[j] = order[j - 1];

@@ -9,13 +9,18 @@
 #ifndef MPM_SOLVER_OPTIONS_H
 #define MPM_SOLVER_OPTIONS_H
 
-#define SOLVER_MAX_OPTS 32
+/* Room for a library's long option names (PETSc's
+ * pc_hypre_boomeramg_strong_threshold is 35 characters; adapters/petsc.c
+ * passes its keys through) and for every option of a solver whose inverse
+ * approximation takes a library's options one by one. */
+#define SOLVER_MAX_OPTS 48
+#define SOLVER_OPT_KEY 48 /* characters of a key, with its NUL */
 typedef struct {
     int n;
-    char key[SOLVER_MAX_OPTS][32];
+    char key[SOLVER_MAX_OPTS][SOLVER_OPT_KEY];
     char value[SOLVER_MAX_OPTS][64];
     int n_asked;                           /* distinct keys looked up */
-    char asked[SOLVER_MAX_OPTS][32];
+    char asked[SOLVER_MAX_OPTS][SOLVER_OPT_KEY];
     char asked_value[SOLVER_MAX_OPTS][64]; /* value in effect */
 } SolverOptions;
 

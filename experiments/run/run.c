@@ -142,19 +142,25 @@ static void load_window_end(LoadWindow *w, int threads)
 }
 
 /* run.json gets "machine_load" once the frames have run. */
-static int add_machine_load(const char *dir, const LoadWindow *w)
+/* Adds key = value (taken) to DIR/run.json, written before the frames ran. */
+static int add_to_run_json(const char *dir, const char *key, json_t *value)
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/run.json", dir);
     json_t *root = json_load_file(path, JSON_DECODE_ANY, NULL);
-    json_t *load = json_pack("{s:f, s:f, s:f, s:i, s:b}", "others_cpu_s", w->others_cpu_s, "elapsed_s", w->elapsed_s,
-                             "load_start", w->load_start, "cores", w->cores, "machine_busy", w->busy);
     int st = MPM_OK;
-    if (!root || !load || json_object_set_new(root, "machine_load", load) ||
+    if (!root || !value || json_object_set_new(root, key, value) ||
         json_dump_file(root, path, JSON_INDENT(2) | JSON_PRESERVE_ORDER) != 0)
         st = mpm_error(MPM_EINPUT, "%s: cannot write", path);
     json_decref(root);
     return st;
+}
+
+static int add_machine_load(const char *dir, const LoadWindow *w)
+{
+    json_t *load = json_pack("{s:f, s:f, s:f, s:i, s:b}", "others_cpu_s", w->others_cpu_s, "elapsed_s", w->elapsed_s,
+                             "load_start", w->load_start, "cores", w->cores, "machine_busy", w->busy);
+    return add_to_run_json(dir, "machine_load", load);
 }
 
 static AccuracyConfig accuracy_config(const RunConfig *cfg)
@@ -498,6 +504,10 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
      * converged at its initial guess) and the named statistics */
     InvView view;
     solver_view(solver, cfg->quiet ? NULL : stdout, &view);
+    /* the library's own view of its last setup (PETSc's KSPView): the
+     * options in effect, defaults included */
+    if (view.library_view[0] && (status = add_to_run_json(out_dir, "inverse_view", json_string(view.library_view))))
+        goto done;
     if (view.n_levels > 0) {
         FILE *lv = open_in(out_dir, "mg_levels.csv", &status);
         if (!lv) goto done;

@@ -60,7 +60,11 @@
 #if MPM_WITH_ML
 #include "adapters/ml.h"
 #endif
+#if MPM_WITH_PETSC
+#include "adapters/petsc.h"
+#endif
 #include "core/error.h"
+#include "core/event_log.h"
 #include "core/problem.h"
 #include "core/vec.h"
 #include "solvers/inverse/jacobi.h"
@@ -222,6 +226,10 @@ typedef struct {
     const Problem *mpm;          /* the MPM Hessian, NULL when it could not be built */
     MpmHessian *hessian;
 } Problems;
+
+static void mpm_hessian_options(FixtureOptions *o);
+static int mpm_hessian_build(MpmHessian *h, Problem *out, const FixtureOptions *opts);
+static void mpm_hessian_free(MpmHessian *h);
 
 struct AdapterRow {
     const char *name; /* as in adapters/adapter_list.h */
@@ -841,6 +849,162 @@ static void ml_own_checks(const AdapterRow *row, const InvApproxOps *ops, Proble
 #endif
 
 /* ---------------------------------------------------------------------------
+ * PETSc's own checks
+ * ------------------------------------------------------------------------- */
+#if MPM_WITH_PETSC
+/* PCG iterations to 1e-8 on the MPM Hessian with `opts` (-1 when it did not set up) */
+static int petsc_pcg_iters(const InvApproxOps *ops, const char *opts, Problems *pr, double *setup_s)
+{
+    InvApprox *M = ready(ops, opts, pr->mpm);
+    if (!M) return -1;
+    double *x = vec_new(len_of(pr->mpm));
+    PcgResult r = run_pcg(pr->mpm, M, pr->hessian->b, x);
+    double res = rel_residual(pr->mpm->A, pr->hessian->b, x);
+    CHECK(res < 1e-6, "petsc %s on the MPM Hessian: PCG residual %g", opts, res);
+    if (setup_s) *setup_s = M->stats.setup_s;
+    free(x);
+    inv_destroy(M);
+    return r.iters;
+}
+
+/* one application of `opts` on the MPM Hessian's gradient (x: 3n) */
+static int petsc_solve_once(const InvApproxOps *ops, const char *opts, Problems *pr, double *x)
+{
+    InvApprox *M = ready(ops, opts, pr->mpm);
+    if (!M) return MPM_EINTERNAL;
+    int st = inv_apply(M, pr->hessian->b, x);
+    CHECK(st == MPM_OK, "petsc %s apply: %s", opts, mpm_last_error());
+    inv_destroy(M);
+    return st;
+}
+
+/* The preset's options (experiments/driver/registry.c, pn-gamg-pcg) */
+#define PETSC_GAMG "pc_type=gamg,pc_gamg_agg_nsmooths=0,mg_levels_ksp_type=chebyshev,mg_levels_pc_type=jacobi"
+/* hypre through PETSc with the boomeramg adapter's defaults (adapters/boomeramg.c) */
+#define PETSC_HYPRE                                                                                                 \
+    "pc_type=hypre,pc_hypre_type=boomeramg,pc_hypre_boomeramg_strong_threshold=0.5,"                                \
+    "pc_hypre_boomeramg_coarsen_type=HMIS,pc_hypre_boomeramg_nodal_coarsen=4,pc_hypre_boomeramg_interp_type=ext+i," \
+    "pc_hypre_boomeramg_P_max=4,pc_hypre_boomeramg_relax_type_all=symmetric-SOR/Jacobi,"                         \
+    "pc_hypre_boomeramg_relax_type_coarse=Gaussian-elimination,pc_hypre_boomeramg_grid_sweeps_all=1,"              \
+    "pc_hypre_boomeramg_no_CF=1"
+/* ML through PETSc with the ml adapter's aggregation options (adapters/ml.c) */
+#define PETSC_ML                                                                                        \
+    "pc_type=ml,pc_ml_maxNlevels=10,pc_ml_maxCoarseSize=512,pc_ml_CoarsenScheme=Uncoupled,pc_ml_Threshold=0," \
+    "pc_ml_DampingFactor=1.3333333333333333,pc_ml_nullspace=user,mg_levels_ksp_type=chebyshev,"             \
+    "mg_levels_pc_type=jacobi,mg_levels_ksp_max_it=2"
+
+static void petsc_own_checks(const AdapterRow *row, const InvApproxOps *ops, Problems *pr)
+{
+    (void)row;
+    if (!pr->mpm) return;
+    const size_t len = len_of(pr->mpm);
+
+    /* GAMG with the rigid-body modes against Jacobi on an elasticity
+     * fixture: one material, dt 0.2 (stiffness well above the mass), a
+     * sticky bottom layer; and on the two-material Hessian */
+    FixtureOptions eo;
+    mpm_hessian_options(&eo);
+    eo.two_materials = 0;
+    eo.F_noise = 0.05;
+    eo.dt = 0.2;
+    MpmHessian eh;
+    Problem ep;
+    if (mpm_hessian_build(&eh, &ep, &eo) == MPM_OK) {
+        Problems epr = *pr;
+        epr.mpm = &ep;
+        epr.hessian = &eh;
+        int gamg = petsc_pcg_iters(ops, PETSC_GAMG, &epr, NULL);
+        int plain = petsc_pcg_iters(ops, PETSC_GAMG ",petsc_rbm=off", &epr, NULL);
+        int jacobi = petsc_pcg_iters(ops, "pc_type=jacobi", &epr, NULL);
+        printf("petsc on the elasticity fixture, PCG to 1e-8: GAMG with rigid-body modes %d iterations, without %d, "
+               "PETSc's Jacobi %d (block Jacobi %d)\n",
+               gamg, plain, jacobi, eh.jacobi_iters);
+        CHECK(gamg > 0 && jacobi > 0 && 3 * gamg < jacobi,
+              "GAMG with rigid-body modes (%d iterations) must need far fewer than Jacobi (%d) on the elasticity "
+              "fixture",
+              gamg, jacobi);
+        mpm_hessian_free(&eh);
+    }
+    {
+        int gamg = petsc_pcg_iters(ops, PETSC_GAMG, pr, NULL), jacobi = petsc_pcg_iters(ops, "pc_type=jacobi", pr, NULL);
+        printf("petsc on the two-material MPM Hessian: GAMG %d iterations, PETSc's Jacobi %d\n", gamg, jacobi);
+        CHECK(gamg > 0 && jacobi > 0 && 2 * gamg < jacobi, "GAMG (%d) vs Jacobi (%d) on the MPM Hessian", gamg, jacobi);
+    }
+
+    /* exact solves: PETSc's LU and Cholesky, MUMPS; against each other and CHOLMOD */
+    static const char *const direct[] = {"pc_type=lu", "pc_type=cholesky", "pc_type=lu,pc_factor_mat_solver_type=mumps",
+                                         "petsc_mat_type=baij,pc_type=lu"};
+    enum { N_DIRECT = sizeof direct / sizeof direct[0] };
+    double *z[N_DIRECT + 1];
+    for (int d = 0; d <= N_DIRECT; ++d) z[d] = vec_new(len);
+    int have_ref = 0;
+#if MPM_WITH_CHOLMOD
+    have_ref = petsc_solve_once(&inv_cholmod_ops, "", pr, z[N_DIRECT]) == MPM_OK;
+#endif
+    for (int d = 0; d < N_DIRECT; ++d) {
+        if (petsc_solve_once(ops, direct[d], pr, z[d])) continue;
+        double res = rel_residual(pr->mpm->A, pr->hessian->b, z[d]);
+        double zmax = 0.0, diff = have_ref ? max_abs_diff(len, z[d], z[N_DIRECT], &zmax) : 0.0;
+        printf("petsc %s on the MPM Hessian: ||Hz-b||/||b|| = %.1e%s", direct[d], res, have_ref ? "" : "\n");
+        if (have_ref) printf(", max |z - z_cholmod| / max |z_cholmod| = %.1e\n", diff / zmax);
+        CHECK(res < 1e-10, "petsc %s: residual %g", direct[d], res);
+        CHECK(!have_ref || diff <= 1e-9 * zmax, "petsc %s against CHOLMOD: max difference %g (max %g)", direct[d], diff,
+              zmax);
+    }
+    for (int d = 0; d <= N_DIRECT; ++d) free(z[d]);
+
+    /* a complete solve (a KSP with its own type) inside PCG: one or two outer iterations */
+    int inner = petsc_pcg_iters(ops, "ksp_type=cg,ksp_rtol=1e-10," PETSC_GAMG, pr, NULL);
+    CHECK(inner >= 0 && inner <= 2, "petsc ksp_type=cg to 1e-10 as the preconditioner: %d PCG iterations", inner);
+
+    /* the cross-checks: PETSc's hypre and ML against the direct adapters with the same options */
+#if MPM_WITH_HYPRE
+    {
+        int via = petsc_pcg_iters(ops, PETSC_HYPRE, pr, NULL), direct_amg = petsc_pcg_iters(&inv_boomeramg_ops, "", pr, NULL);
+        printf("cross-check, PCG to 1e-8 on the MPM Hessian: PETSc pc_type=hypre %d iterations, the boomeramg adapter "
+               "%d\n",
+               via, direct_amg);
+        CHECK(via > 0 && via == direct_amg, "PETSc's hypre (%d) and the boomeramg adapter (%d) with the same options",
+              via, direct_amg);
+    }
+#endif
+#if MPM_WITH_ML
+    {
+        int via = petsc_pcg_iters(ops, PETSC_ML, pr, NULL), direct_ml = petsc_pcg_iters(&inv_ml_ops, "", pr, NULL);
+        printf("cross-check, PCG to 1e-8 on the MPM Hessian: PETSc pc_type=ml %d iterations, the ml adapter %d\n", via,
+               direct_ml);
+        CHECK(via > 0, "PETSc's ML: %d", via);
+    }
+#endif
+
+    /* the copy into PETSc's storage against one SpMV: a second setup on the
+     * same pattern refills the values only (pc_type=none: nothing else) */
+    InvApprox *M = ready(ops, "pc_type=none", pr->mpm);
+    if (M) {
+        double *x = vec_new(len), *y = vec_new(len);
+        synth_random_vector(pr->mpm->n, 5, x);
+        double t0 = event_clock();
+        for (int k = 0; k < 10; ++k) bsr_spmv(pr->mpm->A, x, y);
+        double spmv = (event_clock() - t0) / 10;
+        double setup = 1e300;
+        for (int k = 0; k < 5; ++k) {
+            inv_setup(M, &pr->mpm->in);
+            setup = fmin(setup, M->stats.setup_s);
+        }
+        t0 = event_clock();
+        for (int k = 0; k < 10; ++k) petsc_matvec(M, x, y);
+        double petsc_spmv = (event_clock() - t0) / 10;
+        printf("petsc: refilling the Mat (setup with pc_type=none, same pattern) %.2e s, one bsr_spmv %.2e s (%.1fx), "
+               "PETSc's MatMult %.2e s\n",
+               setup, spmv, setup / spmv, petsc_spmv);
+        free(x);
+        free(y);
+        inv_destroy(M);
+    }
+}
+#endif
+
+/* ---------------------------------------------------------------------------
  * The rows
  * ------------------------------------------------------------------------- */
 #if MPM_WITH_HYPRE
@@ -867,6 +1031,21 @@ static const char *const ml_refused[] = {"ml_smoother=jacobi", "ml_sweeps=0",   
                                          "ml_damping=2.5",     "ml_rbm=yes",      "ml_damping=nan", NULL};
 #endif
 
+#if MPM_WITH_PETSC
+static const char *const petsc_variants[] = {PETSC_GAMG,
+                                             "petsc_mat_type=baij,pc_type=hypre",
+                                             "pc_type=ml",
+                                             "pc_type=gamg,petsc_rbm=off",
+                                             "pc_type=cholesky",
+                                             "ksp_type=cg,ksp_rtol=1e-10",
+                                             NULL};
+static const char *const petsc_refused[] = {"pc_gamg_thresold=0.02", "pc_type=jacobi,pc_gamg_threshold=0.02",
+                                            "pc_type=nosuch",        "pc_gamg_threshold=abc",
+                                            "ksp_monitor=1",         "petsc_rbm=maybe",
+                                            "petsc_mat_type=dense",  NULL};
+static const char *const petsc_mpm_variants[] = {"pc_type=hypre", "pc_type=ml", NULL};
+#endif
+
 static const AdapterRow rows[] = {
 #if MPM_WITH_CHOLMOD
     {.name = "cholmod", .exact = 1, .sym_tol = 1e-10, .own_checks = cholmod_own_checks},
@@ -891,6 +1070,19 @@ static const AdapterRow rows[] = {
      .refused = ml_refused,
      .own_checks = ml_own_checks},
 #endif
+#if MPM_WITH_PETSC
+    /* the default is PETSc's own GAMG (smoothed aggregation): 58 PCG
+     * iterations on the MPM Hessian against block Jacobi's 115 */
+    {.name = "petsc",
+     .sym_tol = 1e-10,
+     .mpm_pcg_factor = 1.5,
+     .hierarchy = petsc_info,
+     .views = {{"Mat", petsc_matvec, 1e-14}},
+     .variants = petsc_variants,
+     .refused = petsc_refused,
+     .mpm_variants = petsc_mpm_variants,
+     .own_checks = petsc_own_checks},
+#endif
     {.name = NULL}};
 
 /* the adapters this build has, by the ops each defines (inv_NAME_ops, adapters/adapter_list.h) */
@@ -906,14 +1098,19 @@ static const struct {
  * The MPM Hessian
  * ------------------------------------------------------------------------- */
 
-static int mpm_hessian_build(MpmHessian *h, Problem *out)
+/* The MPM Hessian of the checks: two materials, 20 particles an axis */
+static void mpm_hessian_options(FixtureOptions *o)
+{
+    fixture_default(o);
+    o->per_axis = 20;
+    o->two_materials = 1;
+    o->F_noise = 0.2;
+}
+
+static int mpm_hessian_build(MpmHessian *h, Problem *out, const FixtureOptions *opts)
 {
     memset(h, 0, sizeof *h);
-    FixtureOptions o;
-    fixture_default(&o);
-    o.per_axis = 20;
-    o.two_materials = 1;
-    o.F_noise = 0.2;
+    FixtureOptions o = *opts;
     int st = fixture_build(&h->f, &o);
     CHECK(st == MPM_OK, "fixture: %s", mpm_last_error());
     if (st) return st;
@@ -950,9 +1147,10 @@ static int mpm_hessian_build(MpmHessian *h, Problem *out)
     out->in = (InvSetupInput){.n_nodes = n, .H = &h->H, .diag = h->diag, .coord = h->f.g.coord,
                               .coloring = &h->f.g.coloring, .op = &h->op, .proj = &h->proj, .problem = pb};
     h->jacobi_iters = jacobi_iters(out, h->b);
-    printf("MPM Hessian: %d nodes (%d Dirichlet), %lld blocks (%.1f per row), dt %g, E 1e4 and 3e6; block-Jacobi "
+    printf("MPM Hessian: %d nodes (%d Dirichlet), %lld blocks (%.1f per row), dt %g, E %s; block-Jacobi "
            "PCG to 1e-8: %d iterations\n",
-           n, pb->n_dirichlet, (long long)h->H.nnzb, (double)h->H.nnzb / n, o.dt, h->jacobi_iters);
+           n, pb->n_dirichlet, (long long)h->H.nnzb, (double)h->H.nnzb / n, o.dt, o.two_materials ? "1e4 and 3e6" : "1e4",
+           h->jacobi_iters);
     return MPM_OK;
 }
 
@@ -986,7 +1184,9 @@ int main(void)
     MpmHessian hessian;
     Problem mpm;
     Problems pr = {.synth = &synth, .other = &other, .hessian = &hessian};
-    if (mpm_hessian_build(&hessian, &mpm) == MPM_OK) pr.mpm = &mpm;
+    FixtureOptions ho;
+    mpm_hessian_options(&ho);
+    if (mpm_hessian_build(&hessian, &mpm, &ho) == MPM_OK) pr.mpm = &mpm;
 
     /* which check ran on which adapter, printed at the end */
     enum { MAX_ADAPTERS = 16 };

@@ -1,0 +1,69 @@
+/* PETSc's KSP and PC as an inverse approximation (docs/design.md, "the one
+ * idea"; docs/solvers.md, "petsc options").
+ *
+ * inv_petsc_ops ("petsc"): setup copies the BC-projected block Hessian into a
+ * PETSc MATSEQBAIJ of block size 3 and sets up a KSP whose type and PC come
+ * from PETSc's own options, given as mpmbench solver options
+ * (`--solver pn:petsc:pc_type=gamg,pc_gamg_threshold=0.02`). apply is
+ *  - with ksp_type=preonly (the default): exactly one PCApply from a zero
+ *    guess, a fixed linear map (symmetric and positive for a symmetric PC:
+ *    GAMG with Chebyshev/Jacobi smoothing, hypre, ML, Jacobi, Cholesky/LU),
+ *    for a PCG preconditioner or an L-BFGS initial inverse Hessian;
+ *  - with any other ksp_type: a complete KSPSolve to the KSP's own
+ *    tolerances (ksp_rtol, ksp_max_it, ...), a variable operator whose
+ *    iterations count as inner iterations.
+ *
+ * Options: every given key starting with ksp_, pc_, mg_, sub_ or mat_ is a
+ * PETSc option (without its leading dash), passed to PETSc under a prefix of
+ * this instance's own; ksp_type (default preonly) and pc_type (default gamg)
+ * are always set. When any is given, create runs the whole set-up once on a
+ * small built-in elasticity-like matrix and refuses (MPM_EINPUT, one line)
+ * an option PETSc did not use (as -options_left would list it) or one PETSc
+ * rejects; options that print (_view, _monitor) are refused. The adapter's
+ * own option: petsc_rbm = on (default): the six rigid-body modes of the
+ * active nodes' coordinates are the matrix's near-null space
+ * (MatNullSpaceCreateRigidBody; GAMG's aggregation uses them), off: none.
+ *
+ * Setup reuse: a rebuild with the same nodes and pattern refills the kept
+ * Mat's values (no new structure) and sets a fresh KSP up; a refresh
+ * (reuse_refresh=1) refills the values and sets the kept KSP up again on
+ * them (PETSc's SAME_NONZERO_PATTERN; GAMG keeps its interpolation with
+ * pc_gamg_reuse_interpolation=1); lagged keeps everything, PETSc holding
+ * its own copy of the matrix.
+ *
+ * MPI and start-up: PETSc needs MPI. Start-up calls MPI_Init when the
+ * program has not initialised MPI (as the hypre and ML adapters do: whoever
+ * comes first starts it, once), then PetscInitialize; at exit PetscFinalize
+ * runs before the MPI_Finalize of whichever adapter started MPI. PETSc runs
+ * on PETSC_COMM_SELF, one thread (Debian's build has no OpenMP); the copy
+ * into PETSc's storage is OpenMP-parallel. */
+#ifndef MPM_PETSC_ADAPTER_H
+#define MPM_PETSC_ADAPTER_H
+
+#include <stddef.h>
+
+#include "solvers/inverse_approx.h"
+
+extern const InvApproxOps inv_petsc_ops;
+
+/* Levels and operator complexity of the last setup's PC when it is a
+ * multigrid one (gamg, ml, mg); 1 and 1.0 otherwise. Either pointer may be
+ * NULL. MPM_EINTERNAL if `self` is not a "petsc" inverse approximation or has
+ * not been set up. */
+int petsc_info(const InvApprox *self, int *levels, double *op_complexity);
+
+/* y = A x with the Mat PETSc holds after the last successful setup (tests:
+ * it equals the Hessian passed in). */
+int petsc_matvec(InvApprox *self, const double *x, double *y);
+
+/* KSPView of the last setup's solver into text (at most cap bytes with the
+ * NUL; a longer view is cut). MPM_EINTERNAL without a setup. */
+int petsc_view_text(const InvApprox *self, char *text, size_t cap);
+
+/* Start-up: MPI_Init when the program has not initialised MPI, then
+ * PetscInitialize. Idempotent. */
+int petsc_library_startup(void);
+/* PETSc's version, e.g. "3.18.5" */
+const char *petsc_library_version(void);
+
+#endif
