@@ -592,6 +592,7 @@ NUMBERS = {
     "ompwait.busy_passive_spread": lambda: omp_wait_spread("one-core-busy", "passive"),
     "ompwait.idle_default_s": lambda: sig(omp_wait_median("idle", "omp_default"), 3),
     "ompwait.date": lambda: omp_wait_date(),
+    "ompwait.runs": lambda: f"{len(rows('omp-wait', 'runs.csv'))} runs",
     "stress.cells": lambda: cells_ok("stress"),
     "stress.date": lambda: run_date("stress"),
     "stress.passed": lambda: check_passed("stress"),
@@ -824,6 +825,11 @@ def check_file(path, text, problems, changed):
         return f"<!-- {kind}:{key} -->{new}<!-- /n -->"
 
     new_text = MARKER.sub(repl, text)
+    if path == os.path.join(RESULTS, "README.md"):  # the index gives every study's status
+        for d in sorted(os.listdir(RESULTS)):
+            if (os.path.isdir(os.path.join(RESULTS, d)) and d != "scenes" and not d.endswith(".new")
+                    and f"<!-- s:{d} -->" not in new_text):
+                problems.append(f"{rel}: results/{d} has no status line (<!-- s:{d} -->)")
     new_text, missing_line = page_first_line(path, new_text)
     if missing_line:
         changed.append(missing_line)
