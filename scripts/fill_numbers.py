@@ -592,6 +592,8 @@ NUMBERS = {
     "ompwait.busy_passive_spread": lambda: omp_wait_spread("one-core-busy", "passive"),
     "ompwait.idle_default_s": lambda: sig(omp_wait_median("idle", "omp_default"), 3),
     "ompwait.date": lambda: omp_wait_date(),
+    "tut.date": lambda: run_date("tutorial-1t-one-core-busy"),
+    "tut.cells": lambda: f"{cells_ok('tutorial-1t-idle')} and {cells_ok('tutorial-1t-one-core-busy')}",
     "ompwait.runs": lambda: f"{len(rows('omp-wait', 'runs.csv'))} runs",
     "stress.cells": lambda: cells_ok("stress"),
     "stress.date": lambda: run_date("stress"),
