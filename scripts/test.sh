@@ -80,9 +80,11 @@ t0=$SECONDS
 # instrumentation runs these tests 2-3x slower, and libomp leaks its thread
 # teams when the thread count changes (test_robust), so the fuzz targets of
 # step 4 get their own build (build-fuzz)
-if [ ! -f build-asan/CMakeCache.txt ]; then
-  cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMPM_SANITIZE=ON >/dev/null
-fi
+# PETSc is off here: on an error (an option it refuses, which the adapter's
+# tests provoke on purpose) PETSc 3.18 does not free the option strings
+# PetscOptionsBegin allocated, which LeakSanitizer reports; configured every
+# time, so an older build-asan/ turns it off too
+cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMPM_SANITIZE=ON -DMPM_WITH_PETSC=OFF >/dev/null
 log=build-asan/build.log
 if ! nice -n 5 cmake --build build-asan -j"$(nproc)" -- --no-print-directory >"$log" 2>&1; then
   cat "$log" >&2
