@@ -68,6 +68,8 @@ MPM_CONFORMANCE_SKIP_MLS=1 ctest --test-dir build-minimal --output-on-failure -j
 echo "test.sh: minimal build and its unit + conformance tests $((SECONDS - t0)) s" >&2
 
 # --- 3. sanitizers ---------------------------------------------------------
+# (test_install is not repeated here: it checks that a release binary holds
+# no source or build path, which a build with debug information does)
 # Tests too slow under ASan for CI's budget are listed here (and printed),
 # never dropped silently; they still run in step 1.
 asan_skip=${MPM_ASAN_SKIP-"test_solvers|test_solvers_mls|test_mg_scene|test_stress_ci|test_matrix_accuracy"} # 385 s and 141 s alone under ASan (release: 52 s, 32 s;
@@ -102,7 +104,7 @@ export MPM_CONFORMANCE_SKIP_MLS=1
 echo "test.sh: ASan+UBSan unit tests (not run under ASan, too slow for CI: ${asan_skip:-none}; test_conformance without its MLS pass)" >&2
 # (the documentation and Python-report tests check text and figures; the C
 # they drive, matrix runs, is under ASan in the other matrix tests)
-ctest --test-dir build-asan --output-on-failure -j2 -E "^(${asan_skip:-none}|test_cli|test_render_cmd|test_scenes_run|test_summarize|test_docs_solvers|test_docs_outputs|test_docs_links|test_fill_numbers|test_matrix_schema|test_matrix_report|test_matrix_report_fixes|test_matrix_report_accuracy)\$"
+ctest --test-dir build-asan --output-on-failure -j2 -E "^(${asan_skip:-none}|test_install|test_cli|test_render_cmd|test_scenes_run|test_summarize|test_docs_solvers|test_docs_outputs|test_docs_links|test_fill_numbers|test_matrix_schema|test_matrix_report|test_matrix_report_fixes|test_matrix_report_accuracy)\$"
 echo "test.sh: sanitizer suite $((SECONDS - t0)) s" >&2
 
 # --- 4. fuzzing ------------------------------------------------------------
