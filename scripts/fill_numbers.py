@@ -71,8 +71,8 @@ class Missing(Exception):
 # ---- reading ---------------------------------------------------------------
 
 _cache = {}
-# what the key being computed reads: its studies and whether a row it read ran busy
-_reading = {"studies": set(), "busy": set()}
+# what the key being computed reads: its studies (doubts() judges each as a whole)
+_reading = {"studies": set()}
 
 
 def reads(study):
@@ -95,8 +95,6 @@ def rows(study, name="report.csv", **where):
     out = [r for r in table(study, name) if all(r.get(k) == v for k, v in where.items())]
     if not out:
         raise Missing(f"results/{study}/{name}: no row with {where}")
-    if any(r.get("machine_busy") not in (None, "", "0") for r in out):
-        _reading["busy"].add(study)
     return out
 
 
@@ -330,14 +328,18 @@ def dec_egap_over_eps(scene, solver, eps):
     return sig(num(r, "e_gap_median") / float(eps), 2)
 
 
-def omp_wait_median(load, wait):
-    """Median s/frame of results/omp-wait's runs of one wait setting under
-    one load (idle runs only when the machine was quiet)."""
+def omp_wait_times(load, wait):
+    """s/frame of results/omp-wait's runs of one wait setting under one load
+    (idle runs only when the machine was quiet)."""
     v = [num(r, "s_per_frame") for r in rows("omp-wait", "runs.csv", load=load, wait=wait)
          if load != "idle" or r["machine_busy"] == "0"]
     if not v:
         raise Missing(f"results/omp-wait: no quiet {load} run of {wait}")
-    return statistics.median(v)
+    return v
+
+
+def omp_wait_median(load, wait):
+    return statistics.median(omp_wait_times(load, wait))
 
 
 def omp_wait_date():
@@ -351,8 +353,7 @@ def omp_wait_ratio(load, wait, base_load, base_wait):
 
 
 def omp_wait_spread(load, wait):
-    v = [num(r, "s_per_frame") for r in rows("omp-wait", "runs.csv", load=load, wait=wait)
-         if load != "idle" or r["machine_busy"] == "0"]
+    v = omp_wait_times(load, wait)
     return f"{sig(min(v), 3)}-{sig(max(v), 3)} s"
 
 
@@ -678,7 +679,7 @@ def value(key):
     """The key's text and what it read: (text, {studies})."""
     if key not in NUMBERS:
         raise Missing(f"unknown key '{key}' (keys: scripts/fill_numbers.py NUMBERS)")
-    _reading["studies"], _reading["busy"] = set(), set()
+    _reading["studies"] = set()
     text = NUMBERS[key]()
     return text, set(_reading["studies"])
 
