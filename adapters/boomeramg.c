@@ -67,6 +67,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "adapters/mpi_startup.h"
 #include "core/error.h"
 
 /* hypre is configured with 32-bit HYPRE_Int/HYPRE_BigInt in Debian 12's
@@ -107,32 +108,24 @@ typedef struct {
     int n;
 } Amg;
 
-static int g_hypre_ready = 0, g_mpi_ours = 0;
+static int g_hypre_ready = 0;
 
-/* At exit: hypre's and (when this adapter started it) MPI's global state is
- * released, so leak checkers see a clean process. */
+/* At exit: hypre's global state is released (before MPI's finaliser,
+ * registered earlier by adapter_mpi_start), so leak checkers see a clean
+ * process. */
 static void hypre_global_finalize(void)
 {
     if (!g_hypre_ready) return;
-    HYPRE_Finalize();
-    int finalized = 0;
-    MPI_Finalized(&finalized);
-    if (g_mpi_ours && !finalized) MPI_Finalize();
+    HYPRE_Finalize(); /* frees hypre's memory; calls no MPI */
     g_hypre_ready = 0;
 }
 
-/* MPI and hypre library initialisation, once per process (header: "MPI"). */
+/* MPI (adapters/mpi_startup.h) and hypre's initialisation, once per process. */
 static int hypre_global_init(void)
 {
     if (g_hypre_ready) return MPM_OK;
-    int inited = 0, finalized = 0;
-    MPI_Initialized(&inited);
-    MPI_Finalized(&finalized);
-    if (finalized) return mpm_error(MPM_EINTERNAL, "boomeramg: MPI has already been finalised");
-    if (!inited) {
-        if (MPI_Init(NULL, NULL) != MPI_SUCCESS) return mpm_error(MPM_EINTERNAL, "boomeramg: MPI_Init failed");
-        g_mpi_ours = 1;
-    }
+    int st = adapter_mpi_start("boomeramg");
+    if (st) return st;
     if (HYPRE_Init() != 0) {
         HYPRE_ClearAllErrors();
         return mpm_error(MPM_EINTERNAL, "boomeramg: HYPRE_Init failed");

@@ -36,12 +36,11 @@
  *                         modes (from InvSetupInput.coord) to the interpolation,
  *                         hypre's InterpVecVariant 1 or 2 (GM) or 3 (LN)
  *
- * MPI: hypre needs MPI. The adapter calls MPI_Init(NULL, NULL) the first time
- * it is set up if the program has not initialised MPI, and HYPRE_Init() once.
- * At exit (atexit) it calls HYPRE_Finalize, and MPI_Finalize when it was the
- * one that initialised MPI, so leak checkers (ASan, valgrind) see a clean
- * process. A program that uses MPI itself must call MPI_Init before the
- * first setup and finalises MPI itself.
+ * MPI: hypre needs MPI. Start-up (or the first setup) starts MPI through the
+ * adapters' one MPI start-up (adapters/mpi_startup.h) and calls HYPRE_Init()
+ * once; at exit HYPRE_Finalize runs before MPI's finaliser, so leak checkers
+ * (ASan, valgrind) see a clean process. A program that uses MPI itself must
+ * call MPI_Init before the first setup and finalises MPI itself.
  * Every solve is local to the calling process: hypre runs on MPI_COMM_SELF,
  * so ranks of a distributed experiment matrix never share a hypre matrix. */
 #ifndef MPM_HYPRE_AMG_H

@@ -40,6 +40,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "adapters/mpi_startup.h"
 #include "core/error.h"
 
 #if !defined(HAVE_MPI)
@@ -71,31 +72,17 @@ typedef struct {
     int cap;
 } Ml;
 
-static int g_ml_mpi_ready = 0, g_ml_mpi_ours = 0;
+static int g_ml_ready = 0;
 
-static void ml_mpi_finalize(void)
-{
-    int finalized = 0;
-    MPI_Finalized(&finalized);
-    if (g_ml_mpi_ours && !finalized) MPI_Finalize();
-}
-
-/* MPI once per process (header: "MPI"); hypre's adapter does the same, so
- * the first one to start MPI finalises it. */
+/* MPI once per process (adapters/mpi_startup.h); ML itself keeps no global
+ * state to finalise. */
 static int ml_mpi_init(void)
 {
-    if (g_ml_mpi_ready) return MPM_OK;
-    int inited = 0, finalized = 0;
-    MPI_Initialized(&inited);
-    MPI_Finalized(&finalized);
-    if (finalized) return mpm_error(MPM_EINTERNAL, "ml: MPI has already been finalised");
-    if (!inited) {
-        if (MPI_Init(NULL, NULL) != MPI_SUCCESS) return mpm_error(MPM_EINTERNAL, "ml: MPI_Init failed");
-        g_ml_mpi_ours = 1;
-        atexit(ml_mpi_finalize);
-    }
+    if (g_ml_ready) return MPM_OK;
+    int st = adapter_mpi_start("ml");
+    if (st) return st;
     ML_Set_PrintLevel(0);
-    g_ml_mpi_ready = 1;
+    g_ml_ready = 1;
     return MPM_OK;
 }
 

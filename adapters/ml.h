@@ -33,10 +33,8 @@
  * amesos-failure.dat in the working folder instead. The coarsest Galerkin
  * matrix of an SPD Hessian is SPD, so this is seen only with a wrong matrix.
  *
- * MPI: ML is built with MPI. The adapter calls MPI_Init(NULL, NULL) at
- * start-up when the program has not initialised MPI (and MPI_Finalize at
- * exit when it was the one), as the hypre adapter does; whichever starts
- * first, MPI is started once. ML runs on MPI_COMM_SELF. ML itself runs on one
+ * MPI: ML is built with MPI. Start-up starts MPI through the adapters' one
+ * MPI start-up (adapters/mpi_startup.h), shared with hypre and PETSc. ML runs on MPI_COMM_SELF. ML itself runs on one
  * thread; only the fine-level matrix-vector products (the project's) are
  * threaded. */
 #ifndef MPM_ML_ADAPTER_H
@@ -65,7 +63,7 @@ int ml_getrow_matvec(InvApprox *self, const double *x, double *y);
  * of the integer node coordinates about their centroid. */
 void ml_rigid_body_modes(int n, const int *coord, double *ns);
 
-/* Start-up: MPI_Init when the program has not initialised MPI. Idempotent. */
+/* Start-up: MPI (adapters/mpi_startup.h). Idempotent. */
 int ml_library_startup(void);
 /* the Trilinos release ML comes from, e.g. "13.2" */
 const char *ml_library_version(void);

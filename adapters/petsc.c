@@ -40,7 +40,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "adapters/mpi_startup.h"
+#include "adapters/petsc_error.h"
+#include "adapters/petsc_hierarchy.h"
 #include "core/error.h"
+#include "solvers/mg/mg.h"
 
 #if defined(PETSC_USE_64BIT_INDICES) || defined(PETSC_USE_COMPLEX) || !defined(PETSC_USE_REAL_DOUBLE)
 #error "adapters/petsc.c expects PETSc with 32-bit PetscInt and real double scalars (Debian's libpetsc-real3.18-dev)"
@@ -60,7 +64,11 @@ typedef struct {
     int options_set; /* the keys are in PETSc's database */
     int complete;    /* ksp_type != preonly: apply is a KSPSolve */
     int rbm;
-    int baij;        /* petsc_mat_type=baij: MATSEQBAIJ; else MATSEQAIJ of block size 3 */
+    int baij;
+    /* petsc_hierarchy: HOT's embedding levels as a PCMG (adapters/petsc_hierarchy.h); NULL = none */
+    PetscHierarchy *hier;
+    const int *coord;                 /* the nodes of the last setup_on (referenced) */
+    const NodeColoring *coloring;        /* petsc_mat_type=baij: MATSEQBAIJ; else MATSEQAIJ of block size 3 */
     /* the matrix; NULL = none */
     Mat A;
     int n;
@@ -81,59 +89,26 @@ typedef struct {
 
 /* ---- start-up, errors ---- */
 
-static int g_petsc_ready = 0, g_petsc_mpi_ours = 0, g_next_prefix = 0;
-static char g_petsc_message[400];
+static int g_petsc_ready = 0, g_next_prefix = 0;
+/* PETSc's return code as an mpm status (adapters/petsc_error.h) */
+static int pk(PetscErrorCode code, int status, const char *what) { return petsc_status(code, status, what); }
 
-/* PETSc's first message of a failure (PETSC_ERROR_INITIAL), on one line;
- * the code is returned, nothing printed. */
-static PetscErrorCode record_error(MPI_Comm comm, int line, const char *fun, const char *file, PetscErrorCode code,
-                                   PetscErrorType type, const char *message, void *ctx)
-{
-    (void)comm, (void)line, (void)file, (void)ctx;
-    if (type == PETSC_ERROR_INITIAL) {
-        snprintf(g_petsc_message, sizeof g_petsc_message, "%s: %s", fun ? fun : "?", message ? message : "");
-        for (char *c = g_petsc_message; *c; ++c)
-            if (*c == '\n' || *c == '\r') *c = ' ';
-    }
-    return code;
-}
-
-/* A PETSc return code as an mpm status: MPM_OK for 0, else `status` with
- * PETSc's message. */
-static int pk(PetscErrorCode code, int status, const char *what)
-{
-    if (!code) return MPM_OK;
-    int st = mpm_error(status, "petsc: %s failed (PETSc error %d: %s)", what, (int)code, g_petsc_message);
-    g_petsc_message[0] = '\0';
-    return st;
-}
-
-/* At exit: PETSc before MPI, and MPI only when this adapter started it. When
- * someone else already finalised MPI (the matrix runner under mpirun), PETSc
- * cannot be finalised any more and is left as it is. */
+/* At exit: PETSc, before MPI's finaliser (registered earlier by
+ * adapter_mpi_start). When the program finalised MPI itself (the matrix
+ * runner under mpirun), PETSc cannot be finalised any more and is left as
+ * it is. */
 static void petsc_at_exit(void)
 {
     if (!g_petsc_ready) return;
-    int finalized = 0;
-    MPI_Finalized(&finalized);
-    if (!finalized) {
-        PetscFinalize();
-        if (g_petsc_mpi_ours) MPI_Finalize();
-    }
+    if (adapter_mpi_running()) PetscFinalize();
     g_petsc_ready = 0;
 }
 
 int petsc_library_startup(void)
 {
     if (g_petsc_ready) return MPM_OK;
-    int inited = 0, finalized = 0;
-    MPI_Initialized(&inited);
-    MPI_Finalized(&finalized);
-    if (finalized) return mpm_error(MPM_EINTERNAL, "petsc: MPI has already been finalised");
-    if (!inited) {
-        if (MPI_Init(NULL, NULL) != MPI_SUCCESS) return mpm_error(MPM_EINTERNAL, "petsc: MPI_Init failed");
-        g_petsc_mpi_ours = 1;
-    }
+    int st = adapter_mpi_start("petsc");
+    if (st) return st;
     /* no signal handlers (the run's own stay), no ~/.petscrc, and no
      * unused-options report at PetscFinalize (the adapter checks its own) */
     static char arg0[] = "mpmbench", arg1[] = "-no_signal_handler", arg2[] = "-skip_petscrc", arg3[] = "-options_left",
@@ -141,12 +116,8 @@ int petsc_library_startup(void)
     static char *argv_store[] = {arg0, arg1, arg2, arg3, arg4, NULL};
     int argc = 5;
     char **argv = argv_store;
-    if (PetscInitialize(&argc, &argv, NULL, NULL)) {
-        if (g_petsc_mpi_ours) MPI_Finalize();
-        g_petsc_mpi_ours = 0;
-        return mpm_error(MPM_EINTERNAL, "petsc: PetscInitialize failed");
-    }
-    PetscPushErrorHandler(record_error, NULL);
+    if (PetscInitialize(&argc, &argv, NULL, NULL)) return mpm_error(MPM_EINTERNAL, "petsc: PetscInitialize failed");
+    PetscPushErrorHandler(petsc_record_error, NULL);
     g_petsc_ready = 1;
     atexit(petsc_at_exit);
     return MPM_OK;
@@ -380,7 +351,11 @@ static int build_solver(Petsc *s, int status)
     if (!st) st = pk(KSPSetOperators(s->ksp, s->A, s->A), MPM_EINTERNAL, "KSPSetOperators");
     /* a zero guess: apply is M r, not a correction of z's old contents */
     if (!st) st = pk(KSPSetInitialGuessNonzero(s->ksp, PETSC_FALSE), MPM_EINTERNAL, "KSPSetInitialGuessNonzero");
+    PC pc = NULL;
+    if (!st && s->hier && !(st = pk(KSPGetPC(s->ksp, &pc), MPM_EINTERNAL, "KSPGetPC")))
+        st = petsc_hierarchy_attach(s->hier, pc, s->n, s->coord, s->coloring);
     if (!st) st = pk(KSPSetFromOptions(s->ksp), status, "KSPSetFromOptions");
+    if (!st && s->hier) st = petsc_hierarchy_configure(s->hier, pc);
     if (!st) st = pk(KSPSetUp(s->ksp), status == MPM_EINPUT ? MPM_EINPUT : MPM_ENUMERIC, "KSPSetUp");
     /* vectors without storage: apply places the caller's arrays */
     if (!st) st = pk(VecCreateSeqWithArray(PETSC_COMM_SELF, 3, N, NULL, &s->b), MPM_EINTERNAL, "VecCreateSeqWithArray");
@@ -395,9 +370,11 @@ static int build_solver(Petsc *s, int status)
 
 /* A full setup on H: the structure when the pattern is new, the values, the
  * near-null space and a new KSP. */
-static int setup_on(Petsc *s, const Bsr *H, const int *coord, int status)
+static int setup_on(Petsc *s, const Bsr *H, const int *coord, const NodeColoring *coloring, int status)
 {
     destroy_solver(s);
+    s->coord = coord;
+    s->coloring = coloring;
     int st = set_options(s);
     if (!st && !same_pattern(s, H)) st = build_structure(s, H);
     if (!st) st = fill_values(s, H);
@@ -462,7 +439,7 @@ static int probe_options(Petsc *s)
     int *coord = NULL;
     int st = probe_matrix(&A, &coord);
     if (st) return st;
-    st = setup_on(s, &A, coord, MPM_EINPUT);
+    st = setup_on(s, &A, coord, NULL, MPM_EINPUT);
     if (!st && s->complete) {
         /* a solve, so that the options a KSPSolve reads are read too */
         Vec b = NULL, x = NULL;
@@ -500,18 +477,68 @@ static void petsc_destroy(InvApprox *self)
     destroy_solver(s);
     destroy_matrix(s);
     clear_options(s);
+    petsc_hierarchy_destroy(s->hier);
     free(s->r_proj);
     free(s->ia);
     free(s->ja);
     free(s);
 }
 
+/* The options of petsc_hierarchy=linear|quadratic (HOT's levels as a PCMG),
+ * read only then, so that they are unknown options without it: the in-house
+ * mg inverse's options and defaults under the prefix petsc_. */
+static int hierarchy_options(SolverOptions *opt, const char *kind, PetscHierarchyOptions *o)
+{
+    int st = MPM_OK;
+    o->kind = !strcmp(kind, "quadratic") ? MG_EMBED_QUADRATIC : MG_EMBED_LINEAR;
+    o->max_levels = solver_opt_int(opt, "petsc_levels", 3, 1, MG_MAX_LEVELS, &st);
+    o->sweeps = solver_opt_int(opt, "petsc_sweeps", 1, 1, 100, &st);
+    o->min_coarse_nodes = solver_opt_int(opt, "petsc_min_coarse_nodes", 300, 1, 1000000000, &st);
+    o->coarse_max_iters = solver_opt_int(opt, "petsc_coarse_max_iters", 10000, 1, 1000000000, &st);
+    o->coarse_tol = solver_opt_number(opt, "petsc_coarse_tol", 0.5, &st);
+    const int exact = solver_opt_int(opt, "petsc_coarse_exact", 0, 0, 1, &st);
+    const char *smoother = solver_opt_string(opt, "petsc_smoother", "sgs");
+    if (st) return st;
+    if (!(o->coarse_tol > 0 && o->coarse_tol < 1))
+        return mpm_error(MPM_EINPUT, "solver option petsc_coarse_tol=%g: expected 0 < tol < 1", o->coarse_tol);
+    if (exact) o->coarse_tol = 1e-12;
+    if (!strcmp(smoother, "sgs")) o->mpm_smoother = 1;
+    else if (!strcmp(smoother, "petsc")) o->mpm_smoother = 0;
+    else return mpm_error(MPM_EINPUT, "solver option petsc_smoother=%s: expected sgs or petsc", smoother);
+    /* what the hierarchy sets itself is not also taken from PETSc's options */
+    const char *ksp_type = solver_opt_string(opt, "ksp_type", "preonly");
+    const char *pc_type = solver_opt_string(opt, "pc_type", "mg");
+    if (strcmp(ksp_type, "preonly"))
+        return mpm_error(MPM_EINPUT, "solver option ksp_type=%s: petsc_hierarchy is one V-cycle (ksp_type=preonly)",
+                         ksp_type);
+    if (strcmp(pc_type, "mg"))
+        return mpm_error(MPM_EINPUT, "solver option pc_type=%s: petsc_hierarchy builds a PCMG (pc_type=mg)", pc_type);
+    for (int i = 0; opt && i < opt->n; ++i) {
+        const char *key = opt->key[i];
+        if (!strncmp(key, "mg_coarse_", 10) || (o->mpm_smoother && !strncmp(key, "mg_levels_", 10)))
+            return mpm_error(MPM_EINPUT, "solver option %s: petsc_hierarchy sets %s itself%s", key,
+                             key[3] == 'c' ? "the coarse solve (HOT's block-Jacobi CG)" : "the smoothers",
+                             key[3] == 'c' ? "" : " with petsc_smoother=sgs (petsc_smoother=petsc takes mg_levels_ options)");
+        if (!strcmp(key, "petsc_mat_type") || !strcmp(key, "petsc_rbm"))
+            return mpm_error(MPM_EINPUT, "solver option %s: not used with petsc_hierarchy (an AIJ matrix, no "
+                             "near-null space)", key);
+    }
+    return MPM_OK;
+}
+
 static int petsc_create(SolverOptions *opt, InvApprox **out)
 {
+    const char *hierarchy = solver_opt_string(opt, "petsc_hierarchy", "none");
+    PetscHierarchyOptions hopt = {0};
+    int hier = strcmp(hierarchy, "none") != 0;
+    if (hier && strcmp(hierarchy, "linear") && strcmp(hierarchy, "quadratic"))
+        return mpm_error(MPM_EINPUT, "solver option petsc_hierarchy=%s: expected none, linear or quadratic", hierarchy);
+    int st = hier ? hierarchy_options(opt, hierarchy, &hopt) : MPM_OK;
+    if (st) return st;
     const char *ksp_type = solver_opt_string(opt, "ksp_type", "preonly");
-    const char *pc_type = solver_opt_string(opt, "pc_type", "gamg");
-    const char *rbm = solver_opt_string(opt, "petsc_rbm", "on");
-    const char *mat_type = solver_opt_string(opt, "petsc_mat_type", "aij");
+    const char *pc_type = solver_opt_string(opt, "pc_type", hier ? "mg" : "gamg");
+    const char *rbm = hier ? "off" : solver_opt_string(opt, "petsc_rbm", "on");
+    const char *mat_type = hier ? "aij" : solver_opt_string(opt, "petsc_mat_type", "aij");
     if (strcmp(mat_type, "aij") && strcmp(mat_type, "baij"))
         return mpm_error(MPM_EINPUT, "solver option petsc_mat_type=%s: expected aij or baij", mat_type);
     int r;
@@ -523,11 +550,14 @@ static int petsc_create(SolverOptions *opt, InvApprox **out)
     s->base.ops = &inv_petsc_ops;
     s->rbm = r;
     s->baij = !strcmp(mat_type, "baij");
+    if (hier && (st = petsc_hierarchy_create(&hopt, &s->hier))) {
+        free(s);
+        return st;
+    }
     s->nnzb = -1;
     snprintf(s->prefix, sizeof s->prefix, "mpm%d_", g_next_prefix++);
     add_key(s, "ksp_type", ksp_type);
     add_key(s, "pc_type", pc_type);
-    int st = MPM_OK;
     for (int i = 0; opt && i < opt->n && !st; ++i) {
         const char *key = opt->key[i];
         if (!is_petsc_key(key) || !strcmp(key, "ksp_type") || !strcmp(key, "pc_type")) continue;
@@ -554,6 +584,11 @@ static int petsc_create(SolverOptions *opt, InvApprox **out)
     /* a KSP to its tolerance is not a fixed linear map; one PCApply is
      * (symmetric for the symmetric PCs the presets use) */
     s->base.caps = INV_NEEDS_HESSIAN | INV_POSITIVE | (s->complete ? INV_VARIABLE | INV_INNER_ITERS : INV_SYMMETRIC);
+    if (hier) { /* as the in-house mg: an adaptive coarse CG, unless to 1e-12 (then symmetric) */
+        s->base.caps = INV_NEEDS_HESSIAN | INV_POSITIVE | INV_INNER_ITERS |
+                       (hopt.coarse_tol <= 1e-12 ? INV_SYMMETRIC : INV_VARIABLE);
+        s->base.flexible = hopt.max_levels > 1 && solver_opt_int(opt, "flexible", 1, 0, 1, &st);
+    }
     /* Debian's PETSc runs on one thread; only the copy into it is threaded */
     s->base.setup_threads = s->base.apply_threads = 1;
     if (!st && s->n_given > 0 && (st = probe_options(s)) && !strstr(mpm_last_error(), "solver option")) {
@@ -607,7 +642,7 @@ static int petsc_setup(InvApprox *self, const InvSetupInput *in)
         s->ready = 1;
         return MPM_OK;
     }
-    int st = setup_on(s, H, in->coord, MPM_EINTERNAL);
+    int st = setup_on(s, H, in->coord, in->coloring, MPM_EINTERNAL);
     if (!st) st = take_projection(s, in);
     if (st) {
         destroy_solver(s);
@@ -645,7 +680,10 @@ static int petsc_apply(InvApprox *self, const double *r, double *z)
     Petsc *s = (Petsc *)self;
     if (s->n == 0 && s->ready) return MPM_OK;
     if (!s->ready) return mpm_error(MPM_EINTERNAL, "petsc: apply without a successful setup");
-    if (s->proj) {
+    /* HOT's levels: the input and output as the in-house V-cycle has them
+     * (projected only when the hierarchy is one level, a plain PCG) */
+    const int project = s->proj && (!s->hier || petsc_hierarchy_levels(s->hier) == 1);
+    if (project) {
         memcpy(s->r_proj, r, sizeof(double) * 3 * (size_t)s->n);
         projection_apply(s->proj, s->r_proj);
         r = s->r_proj;
@@ -656,7 +694,9 @@ static int petsc_apply(InvApprox *self, const double *r, double *z)
     if (!s->complete) {
         PC pc = NULL;
         st = pk(KSPGetPC(s->ksp, &pc), MPM_EINTERNAL, "KSPGetPC");
+        if (!st && s->hier) st = petsc_hierarchy_prepare(s->hier, r);
         if (!st) st = pk(PCApply(pc, s->b, s->x), MPM_ENUMERIC, "PCApply");
+        if (!st && s->hier) st = petsc_hierarchy_finish(s->hier, &self->stats.inner_iters);
     } else {
         st = pk(KSPSolve(s->ksp, s->b, s->x), MPM_ENUMERIC, "KSPSolve");
         PetscInt its = 0;
@@ -672,7 +712,7 @@ static int petsc_apply(InvApprox *self, const double *r, double *z)
     }
     VecResetArray(s->b);
     VecResetArray(s->x);
-    if (!st && s->proj) projection_apply(s->proj, z);
+    if (!st && project) projection_apply(s->proj, z);
     return st;
 }
 
@@ -746,6 +786,11 @@ static void petsc_view(const InvApprox *self, FILE *f, InvView *out)
                 3 * s->n, levels, cx);
     inv_view_add(out, "levels", levels);
     inv_view_add(out, "operator_complexity", cx);
+    if (s->hier) {
+        PC pc = NULL;
+        if (s->ksp) KSPGetPC(s->ksp, &pc);
+        petsc_hierarchy_view(s->hier, pc, out);
+    }
     inv_view_add(out, "library_threads", 1);
     if (out && s->ksp && petsc_view_text(self, out->library_view, sizeof out->library_view) != MPM_OK) {
         mpm_clear_error();

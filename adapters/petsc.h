@@ -31,10 +31,10 @@
  * pc_gamg_reuse_interpolation=1); lagged keeps everything, PETSc holding
  * its own copy of the matrix.
  *
- * MPI and start-up: PETSc needs MPI. Start-up calls MPI_Init when the
- * program has not initialised MPI (as the hypre and ML adapters do: whoever
- * comes first starts it, once), then PetscInitialize; at exit PetscFinalize
- * runs before the MPI_Finalize of whichever adapter started MPI. PETSc runs
+ * MPI and start-up: PETSc needs MPI. Start-up starts it through the
+ * adapters' one MPI start-up (adapters/mpi_startup.h, shared with hypre and
+ * ML), then calls PetscInitialize; at exit PetscFinalize runs before MPI's
+ * finaliser. PETSc runs
  * on PETSC_COMM_SELF, one thread (Debian's build has no OpenMP); the copy
  * into PETSc's storage is OpenMP-parallel. */
 #ifndef MPM_PETSC_ADAPTER_H
@@ -60,8 +60,7 @@ int petsc_matvec(InvApprox *self, const double *x, double *y);
  * NUL; a longer view is cut). MPM_EINTERNAL without a setup. */
 int petsc_view_text(const InvApprox *self, char *text, size_t cap);
 
-/* Start-up: MPI_Init when the program has not initialised MPI, then
- * PetscInitialize. Idempotent. */
+/* Start-up: MPI (adapters/mpi_startup.h), then PetscInitialize. Idempotent. */
 int petsc_library_startup(void);
 /* PETSc's version, e.g. "3.18.5" */
 const char *petsc_library_version(void);

@@ -9,7 +9,9 @@ A part may include the headers of the parts listed for it in PARTS below and
 the third-party headers listed for it, nothing else: a header of a higher
 floor or of a sideways part is an error, so is a third-party header outside
 its floor (the compiler finds jansson.h or mpi.h from anywhere). Adapters see
-only their own header among the adapters, and only the registry reads the
+only their own headers among the adapters (adapters/NAME.h and the
+headers of their parts adapters/NAME_*.h) and the shared modules (the MPI
+start-up), and only the registry reads the
 adapters' list. Modules (a .c with its .h) must not
 include each other in a circle.
 
@@ -55,6 +57,8 @@ GENERATED = {"mpm_build_info.h": "run", "mpm_adapters_built.h": "adapters"}
 # the registry is the one meeting point of the adapters and the rest: it alone
 # reads their list (no file outside adapters/ includes an adapter's header)
 MEETING_POINT = ("experiments/driver/registry.c", "adapters/adapter_list.h")
+# modules under adapters/ that every adapter may use: they belong to no adapter
+SHARED_ADAPTER_MODULES = {"adapters/mpi_startup"}
 SOURCE_EXT = (".c", ".h", ".inc")
 # a test's floor: the parts its #include lines may name (its floor and those below)
 TEST_FLOORS = {
@@ -90,6 +94,12 @@ def sources(root):
 
 def module(path):
     return os.path.splitext(path)[0]
+
+
+def adapter_of(path):
+    """The adapter a file under adapters/ belongs to: NAME for adapters/NAME.c
+    and its own parts adapters/NAME_*.c (and their headers)."""
+    return os.path.basename(module(path)).split("_")[0]
 
 
 def find_cycle(edges):
@@ -155,7 +165,8 @@ def check(root):
                     errors.append('%s: includes "%s": the %s part may use only %s' %
                                   (where, name, part, ", ".join(sorted(allowed_parts))))
                     continue
-                if part == "adapters" and target == "adapters" and module(name) != module(path):
+                if part == "adapters" and target == "adapters" and adapter_of(name) != adapter_of(path) \
+                        and module(name) not in SHARED_ADAPTER_MODULES:
                     errors.append('%s: includes "%s": an adapter sees no other adapter' % (where, name))
                     continue
                 if module(name) != module(path):

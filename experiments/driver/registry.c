@@ -74,6 +74,14 @@ static const SolverPreset g_presets[] = {
      * measured (results/smoother-precision; SPEC 6.10) */
     {"hot", "L-BFGS, initial inverse = one linear-embedding Galerkin multigrid V-cycle built once per step (HOT)",
      "lbfgs", "mg", "smoother_precision=single"},
+    /* HOT's hierarchy run by PETSc (adapters/petsc_hierarchy.h): the same
+     * levels and coloured SGS smoothing as hot (in double precision), the
+     * prolongations as PETSc matrices, the Galerkin products by PETSc's
+     * MatPtAP; its V-cycle equals the in-house one to round-off
+     * (tests/conformance/test_adapters.c) */
+    {"hot-petsc", "HOT with its multigrid run by PETSc: L-BFGS, initial inverse = one V-cycle of a PETSc PCMG on "
+     "HOT's linear-embedding levels (Galerkin by MatPtAP, coloured SGS smoother)", "lbfgs", "petsc",
+     "petsc_hierarchy=linear"},
     {"hot-quadratic", "HOT with the quadratic embedding kernel", "lbfgs", "mg",
      "embedding=quadratic,smoother_precision=single"},
     {"lbfgs-gmg", "L-BFGS, initial inverse = one V-cycle of particle-rediscretised geometric multigrid (HOT LBFGS-GMG)",

@@ -5,7 +5,8 @@
 # another PC), one PETSc refuses (an unknown type, a non-number) and one that
 # prints are each one line on stderr and exit 2, before any output; the
 # presets run, and run.json records PETSc's version, the options given with
-# the two defaults, and PETSc's own KSPView of the last setup.
+# the two defaults, and PETSc's own KSPView of the last setup; hot-petsc
+# (HOT's hierarchy as a PCMG) takes the in-house HOT's iterations step by step.
 . "$(dirname "$0")/../common/shell_harness.sh"
 export OMP_NUM_THREADS=1
 run=(run --scene bar3 --scale 6 --frames 1 --quiet)
@@ -23,7 +24,12 @@ expect_input_error "pc_gamg_threshold=abc.*no numeric value" "${run[@]}" --out "
   --solver pn:petsc:pc_gamg_threshold=abc
 expect_input_error "ksp_monitor: PETSc options that print" "${run[@]}" --out "$tmp/x6" --solver pn:petsc:ksp_monitor=1
 expect_input_error "petsc_rbm=maybe: expected on or off" "${run[@]}" --out "$tmp/x7" --solver lbfgs-gamg:petsc_rbm=maybe
-for d in x1 x2 x3 x4 x5 x6 x7; do
+# HOT's hierarchy: its options exist only with it, and it sets the smoothers itself
+expect_input_error "petsc_levels=3: pn:petsc:petsc_levels=3 has no option 'petsc_levels'" "${run[@]}" --out "$tmp/x8" \
+  --solver pn:petsc:petsc_levels=3
+expect_input_error "mg_levels_ksp_type: petsc_hierarchy sets the smoothers itself" "${run[@]}" --out "$tmp/x9" \
+  --solver hot-petsc:mg_levels_ksp_type=chebyshev
+for d in x1 x2 x3 x4 x5 x6 x7 x8 x9; do
   check "refused before any output ($d)" test ! -e "$tmp/$d"
 done
 
@@ -48,4 +54,23 @@ print("ok")
 PY
 check "run.json: PETSc's version, the options with their defaults, PETSc's KSPView ($(tail -1 "$tmp/json.txt"))" \
   grep -qx ok "$tmp/json.txt"
+# hot-petsc is HOT's V-cycle run by PETSc: on the same steps it takes the
+# in-house double-precision HOT's iterations, inner (coarse CG) iterations
+# and line-search evaluations, step by step
+hot=(run --scene bar3 --scale 3 --frames 2 --quiet)
+"$bin" "${hot[@]}" --solver hot-petsc --out "$tmp/hot-petsc" >"$tmp/hp.log" 2>&1
+check "hot-petsc runs: exit 0 ($(tail -1 "$tmp/hp.log"))" test $? -eq 0
+"$bin" "${hot[@]}" --solver hot:smoother_precision=double --out "$tmp/hot" >"$tmp/h.log" 2>&1
+check "hot (double) runs: exit 0 ($(tail -1 "$tmp/h.log"))" test $? -eq 0
+python3 - "$tmp/hot-petsc" "$tmp/hot" >"$tmp/agree.txt" 2>&1 <<'PY'
+import csv, sys
+a, b = (list(csv.DictReader(open(f"{d}/steps.csv"))) for d in sys.argv[1:3])
+assert len(a) == len(b) and len(a) >= 4, (len(a), len(b))
+for x, y in zip(a, b):
+    for k in ("outer_iters", "inner_iters", "ls_evals", "status", "dt"):
+        assert x[k] == y[k], (k, x["frame"], x["step"], x[k], y[k])
+print("ok: %d steps, %d outer and %d inner iterations on both" % (len(a), sum(int(s["outer_iters"]) for s in a),
+                                                                  sum(int(s["inner_iters"]) for s in a)))
+PY
+check "hot-petsc and hot take the same iterations step by step ($(tail -1 "$tmp/agree.txt"))" grep -q "^ok" "$tmp/agree.txt"
 finish

@@ -62,6 +62,7 @@
 #endif
 #if MPM_WITH_PETSC
 #include "adapters/petsc.h"
+#include "solvers/mg/mg.h"
 #endif
 #include "core/error.h"
 #include "core/event_log.h"
@@ -893,6 +894,61 @@ static int petsc_solve_once(const InvApproxOps *ops, const char *opts, Problems 
     "pc_ml_DampingFactor=1.3333333333333333,pc_ml_nullspace=user,mg_levels_ksp_type=chebyshev,"             \
     "mg_levels_pc_type=jacobi,mg_levels_ksp_max_it=2"
 
+/* z = M b with `opts` on the MPM Hessian, and M's levels (0: failed) */
+static int apply_once(const InvApproxOps *ops, const char *opts, Problems *pr, double *z, int *levels)
+{
+    InvApprox *M = ready(ops, opts, pr->mpm);
+    if (!M) return MPM_EINTERNAL;
+    int st = inv_apply(M, pr->hessian->b, z);
+    CHECK(st == MPM_OK, "%s %s apply: %s", ops->name, opts, mpm_last_error());
+    InvView v;
+    memset(&v, 0, sizeof v);
+    inv_view(M, NULL, &v);
+    *levels = v.n_levels;
+    inv_destroy(M);
+    return st;
+}
+
+static void petsc_pcmg_checks(const InvApproxOps *ops, Problems *pr)
+{
+    const size_t len = len_of(pr->mpm);
+    /* coarse_exact: the coarse CG to 1e-12, so both cycles are fixed maps;
+     * then the adaptive one (the same CG iterations, the same cycle) */
+    static const char *const pairs[][2] = {
+        {"coarse_exact=1,min_coarse_nodes=100", "petsc_hierarchy=linear,petsc_coarse_exact=1,petsc_min_coarse_nodes=100"},
+        {"min_coarse_nodes=100", "petsc_hierarchy=linear,petsc_min_coarse_nodes=100"},
+        {"embedding=quadratic,min_coarse_nodes=100,sweeps=2",
+         "petsc_hierarchy=quadratic,petsc_min_coarse_nodes=100,petsc_sweeps=2"}};
+    for (size_t k = 0; k < sizeof pairs / sizeof pairs[0]; ++k) {
+        double *z_mg = vec_new(len), *z_petsc = vec_new(len);
+        int l_mg = 0, l_petsc = 0;
+        if (!apply_once(&inv_mg_ops, pairs[k][0], pr, z_mg, &l_mg) &&
+            !apply_once(ops, pairs[k][1], pr, z_petsc, &l_petsc)) {
+            double zmax = 0.0, diff = max_abs_diff(len, z_petsc, z_mg, &zmax);
+            printf("PCMG with the SGS shell smoother (%s) against the in-house V-cycle (%s): %d and %d levels, "
+                   "max |z_petsc - z_mg| / max |z_mg| = %.1e\n",
+                   pairs[k][1], pairs[k][0], l_petsc, l_mg, diff / zmax);
+            CHECK(l_mg >= 3 && l_petsc == l_mg, "PCMG levels %d, in-house %d (at least 3 expected)", l_petsc, l_mg);
+            CHECK(zmax > 0 && diff <= 1e-12 * zmax, "PCMG (%s) against the in-house V-cycle: max difference %g (max %g)",
+                  pairs[k][1], diff, zmax);
+        }
+        free(z_mg);
+        free(z_petsc);
+    }
+    /* as a PCG preconditioner: the in-house cycle's iterations, and with
+     * PETSc's own smoothers a preconditioner far better than block Jacobi */
+    int mg = petsc_pcg_iters(&inv_mg_ops, "min_coarse_nodes=100", pr, NULL);
+    int pcmg = petsc_pcg_iters(ops, "petsc_hierarchy=linear,petsc_min_coarse_nodes=100", pr, NULL);
+    /* PETSc's default level smoothers (Chebyshev with SOR, 2 iterations) */
+    int cheb = petsc_pcg_iters(ops, "petsc_hierarchy=linear,petsc_min_coarse_nodes=100,petsc_smoother=petsc", pr, NULL);
+    printf("PCG to 1e-8 on the MPM Hessian: in-house V-cycle %d iterations, PCMG with the SGS shell %d, PCMG with "
+           "PETSc's default smoothers (Chebyshev/SOR) %d, block Jacobi %d\n",
+           mg, pcmg, cheb, pr->hessian->jacobi_iters);
+    CHECK(mg > 0 && pcmg == mg, "PCG with PCMG (%d iterations) and with the in-house V-cycle (%d)", pcmg, mg);
+    CHECK(cheb > 0 && 3 * cheb < pr->hessian->jacobi_iters, "PCMG with PETSc's smoothers: %d PCG iterations, block "
+          "Jacobi %d", cheb, pr->hessian->jacobi_iters);
+}
+
 static void petsc_own_checks(const AdapterRow *row, const InvApproxOps *ops, Problems *pr)
 {
     (void)row;
@@ -977,6 +1033,11 @@ static void petsc_own_checks(const AdapterRow *row, const InvApproxOps *ops, Pro
     }
 #endif
 
+    /* HOT's hierarchy as a PCMG against the in-house V-cycle (solvers/mg):
+     * the same levels, with mpmbench's coloured SGS as the PCSHELL smoother
+     * the same cycle to round-off; with PETSc's smoothers a working one */
+    petsc_pcmg_checks(ops, pr);
+
     /* the copy into PETSc's storage against one SpMV: a second setup on the
      * same pattern refills the values only (pc_type=none: nothing else) */
     InvApprox *M = ready(ops, "pc_type=none", pr->mpm);
@@ -1038,11 +1099,22 @@ static const char *const petsc_variants[] = {PETSC_GAMG,
                                              "pc_type=gamg,petsc_rbm=off",
                                              "pc_type=cholesky",
                                              "ksp_type=cg,ksp_rtol=1e-10",
+                                             "petsc_hierarchy=linear",
+                                             "petsc_hierarchy=linear,petsc_smoother=petsc,mg_levels_ksp_type=richardson,"
+                                             "mg_levels_pc_type=sor",
                                              NULL};
 static const char *const petsc_refused[] = {"pc_gamg_thresold=0.02", "pc_type=jacobi,pc_gamg_threshold=0.02",
                                             "pc_type=nosuch",        "pc_gamg_threshold=abc",
                                             "ksp_monitor=1",         "petsc_rbm=maybe",
-                                            "petsc_mat_type=dense",  NULL};
+                                            "petsc_mat_type=dense",
+                                            /* HOT's hierarchy: its options only with it, and what it sets itself */
+                                            "petsc_hierarchy=cubic",
+                                            "pc_type=gamg,petsc_hierarchy=linear",
+                                            "ksp_type=cg,petsc_hierarchy=linear",
+                                            "mg_levels_ksp_type=chebyshev,petsc_hierarchy=linear",
+                                            "mg_coarse_ksp_type=cg,petsc_hierarchy=linear,petsc_smoother=petsc",
+                                            "petsc_coarse_tol=1,petsc_hierarchy=linear",
+                                            "petsc_smoother=jacobi,petsc_hierarchy=linear", NULL};
 static const char *const petsc_mpm_variants[] = {"pc_type=hypre", "pc_type=ml", NULL};
 #endif
 
