@@ -24,6 +24,14 @@
  * active nodes' coordinates are the matrix's near-null space
  * (MatNullSpaceCreateRigidBody; GAMG's aggregation uses them), off: none.
  *
+ * petsc_hierarchy = linear | quadratic (default none): the PC is a PCMG on
+ * HOT's node-embedding levels (adapters/petsc_hierarchy.h), with the mg
+ * inverse's options under the prefix petsc_ (petsc_levels, petsc_sweeps,
+ * petsc_min_coarse_nodes, petsc_coarse_tol, petsc_coarse_max_iters,
+ * petsc_coarse_exact) and petsc_smoother = sgs (the coloured SGS as a
+ * PCSHELL, default) | petsc (PETSc's, from mg_levels_ options); apply then
+ * is the in-house V-cycle's map (variable, unprojected).
+ *
  * Setup reuse: a rebuild with the same nodes and pattern refills the kept
  * Mat's values (no new structure) and sets a fresh KSP up; a refresh
  * (reuse_refresh=1) refills the values and sets the kept KSP up again on
