@@ -3,6 +3,7 @@
 
     python3 scripts/baselines_table.py results/baselines > results/baselines/tables.md
     python3 scripts/baselines_table.py results/baselines-repeat > results/baselines-repeat/spread.md
+    python3 scripts/baselines_table.py results/petsc-baselines > results/petsc-baselines/tables.md
 
 From a finished experiments/matrices/baselines.json run: seconds per timed
 frame of every solver per scene and thread count, then HOT's lead over the
@@ -11,7 +12,8 @@ the fastest of everything else, then per cell the outer and linear
 iterations, the share of the timed steps spent in the setup and the last
 hierarchy's operator complexity. Cells that did not converge or ran on a
 busy machine are marked and not compared. A run with repeats gets the
-spread table instead (spread()).
+spread table instead (spread(): two solvers; repeated(): more, every
+number from the medians of the runs).
 """
 import math
 import os
@@ -19,7 +21,102 @@ import sys
 
 from setting_table import counters, read_csv, setup_share
 
-ALGEBRAIC = ("pn-amg-pcg", "lbfgs-amg", "pn-ml-pcg", "lbfgs-ml")
+ALGEBRAIC = ("pn-amg-pcg", "lbfgs-amg", "pn-ml-pcg", "lbfgs-ml", "pn-gamg-pcg", "lbfgs-gamg")
+
+
+def algebraic(solver):
+    """An algebraic multigrid: a tuned preset, or PETSc's hypre, ML or GAMG by pc_type."""
+    return solver.split(":")[0] in ALGEBRAIC or any(f":petsc:pc_type={p}" in solver for p in ("hypre", "ml", "gamg"))
+
+
+def median(v):
+    v = sorted(v)
+    return v[len(v) // 2] if len(v) % 2 else (v[len(v) // 2 - 1] + v[len(v) // 2]) / 2
+
+
+def repeated(d, cells):
+    """For a run with repeats of more than two solvers: per scene and thread
+    count, every solver's median s/frame over its runs with the spread
+    ((max - min) / median), HOT's lead over each from the medians with the
+    range over all pairs of runs, and the iterations, setup share and
+    operator complexity of each solver's median run."""
+    runs = {}
+    for r in cells:
+        runs.setdefault((r["scene"], r["threads"], r["solver"]), []).append(r)
+    scenes = list(dict.fromkeys(r["scene"] for r in cells))
+    solvers = list(dict.fromkeys(r["solver"] for r in cells))
+    threads = sorted({r["threads"] for r in cells}, key=int, reverse=True)
+
+    def times(key):
+        return [float(r["s_per_frame"]) for r in runs.get(key, []) if good(r)]
+
+    def median_run(key):
+        ok = sorted((r for r in runs.get(key, []) if good(r)), key=lambda r: float(r["s_per_frame"]))
+        return ok[(len(ok) - 1) // 2] if ok else (runs.get(key) or [None])[0]
+
+    print("## Seconds per timed frame: median of the runs (spread)\n")
+    print("Solvers: " + ", ".join(f"{chr(65 + i)} = `{so}`" for i, so in enumerate(solvers)) + "\n")
+    print("| scene | threads | runs | " + " | ".join(chr(65 + i) for i in range(len(solvers))) + " |")
+    print("|---|---:|---:|" + "---:|" * len(solvers))
+    for sc in scenes:
+        for t in threads:
+            row, n = [], 0
+            for so in solvers:
+                v = times((sc, t, so))
+                n = max(n, len(v))
+                if v:
+                    row.append(f"{median(v):.3g} ({(max(v) - min(v)) / median(v):.0%})")
+                else:
+                    r = median_run((sc, t, so))
+                    row.append(f"- ({r['worst_solve_status'] or r['status']})" if r else "")
+            print(f"| {sc} | {t} | {n} | " + " | ".join(row) + " |")
+
+    print("\n## Each solver's median s/frame over HOT's (range over all pairs of runs)\n")
+    others = [so for so in solvers if so != "hot"]
+    print("| scene | threads | " + " | ".join(chr(65 + solvers.index(so)) for so in others) + " |")
+    print("|---|---:|" + "---:|" * len(others))
+    leads = {t: [] for t in threads}
+    for sc in scenes:
+        for t in threads:
+            h = times((sc, t, "hot"))
+            if not h:
+                continue
+            row = []
+            best = None
+            for so in others:
+                v = times((sc, t, so))
+                if not v:
+                    row.append("-")
+                    continue
+                pairs = [y / x for x in h for y in v]
+                ratio = median(v) / median(h)
+                row.append(f"{ratio:.2f} ({min(pairs):.2f}-{max(pairs):.2f})")
+                if algebraic(so) and (best is None or ratio < best):
+                    best = ratio
+            if best is not None:
+                leads[t].append(best)
+            print(f"| {sc} | {t} | " + " | ".join(row) + " |")
+    for t in threads:
+        v = leads[t]
+        if v:
+            g = math.exp(sum(math.log(x) for x in v) / len(v))
+            print(f"\nAt {t} thread{'s' if t != '1' else ''}: the fastest algebraic multigrid of each scene takes {g:.2f}x "
+                  f"HOT's median time (geometric mean over {len(v)} scenes, {min(v):.2f}-{max(v):.2f}).")
+
+    print("\n## Iterations, setup share, operator complexity (each solver's median run)\n")
+    print("| scene | threads | solver | s/frame | outer | linear | inner | setup share | op. complexity | status |")
+    print("|---|---:|---|---:|---:|---:|---:|---:|---:|---|")
+    for sc in scenes:
+        for t in threads:
+            for so in solvers:
+                r = median_run((sc, t, so))
+                if not r:
+                    continue
+                st = r["worst_solve_status"] or r["status"]
+                if r.get("machine_busy", "0") == "1":
+                    st += " (machine busy)"
+                print(f"| {sc} | {t} | {so} | {float(r['s_per_frame'] or 'nan'):.3g} | {r['outer_iters']} | "
+                      f"{r['linear_iters']} | {r['inner_iters']} | {setup_share(d, r):.0%} | {op_complexity(d, r)} | {st} |")
 
 
 def good(r):
@@ -60,7 +157,10 @@ def main(d):
     if not cells:
         sys.exit(f"{d}/cells.csv: no cells")
     if any(r.get("repeat", "") not in ("", "1") for r in cells):
-        spread(d)
+        if len({r["solver"] for r in cells}) > 2:
+            repeated(d, cells)
+        else:
+            spread(d)
         return
     scenes = list(dict.fromkeys(r["scene"] for r in cells))
     solvers = list(dict.fromkeys(r["solver"] for r in cells))
