@@ -12,7 +12,8 @@ and the last hierarchy's operator complexity (inverse_stats.csv) and the
 status. Then, per setting, the geometric mean
 of the ratio over the groups where every setting ended converged, so a
 setting is judged on all scenes at once. Cells that ran while the machine
-was busy are marked and left out of the means.
+was busy are marked and left out of the means. A run with repeats gets
+medians and the adoption rule instead (repeated()).
 """
 import csv
 import math
@@ -48,12 +49,91 @@ def ok(r):
     return r["status"] == "ok" and r["worst_solve_status"] == "converged"
 
 
+def median(v):
+    v = sorted(v)
+    return v[len(v) // 2] if len(v) % 2 else (v[len(v) // 2 - 1] + v[len(v) // 2]) / 2
+
+
+def repeated(d, cells, axis):
+    """A tuning run with repeats: per scene and solver form, each setting's
+    median s/frame over its converged runs on a quiet machine, the spread,
+    the ratio to the first setting's median, the iterations of the median
+    run; then the adoption rule of the tuning matrices (written in their
+    descriptions): a setting beats the first one for a solver when it
+    converged in every run of every scene and its median is lower on every
+    scene where the first converged (a scene the first failed counts as a
+    win); of the winners, the lowest geometric mean of the ratios."""
+    settings = list(dict.fromkeys(r[axis] for r in cells))
+    scenes = list(dict.fromkeys(r["scene"] for r in cells))
+    solvers = list(dict.fromkeys(r["solver"] for r in cells))
+    runs = {}
+    for r in cells:
+        runs.setdefault((r["scene"], r["solver"], r["threads"], r[axis]), []).append(r)
+
+    def quiet_ok(r):
+        return ok(r) and r.get("machine_busy", "0") != "1"
+
+    print(f"| scene | solver | threads | {axis} | runs | s/frame: median (spread) | / first | outer | linear |"
+          " setup share | op. complexity | status |")
+    print("|---|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|")
+    med = {}
+    failed = {}
+    for (scene, solver, threads, setting), rows in sorted(
+            runs.items(), key=lambda kv: (scenes.index(kv[0][0]), solvers.index(kv[0][1]), kv[0][2],
+                                          settings.index(kv[0][3]))):
+        good = sorted((r for r in rows if quiet_ok(r)), key=lambda r: float(r["s_per_frame"]))
+        bad = [r for r in rows if not ok(r)]
+        failed[(scene, solver, setting)] = bool(bad)
+        r = good[(len(good) - 1) // 2] if good else rows[0]
+        t = [float(x["s_per_frame"]) for x in good]
+        m = median(t) if t else float("nan")
+        med[(scene, solver, setting)] = m if not bad else float("nan")
+        first = med.get((scene, solver, settings[0]), float("nan"))
+        ratio = m / first if not bad and first == first and first > 0 else float("nan")
+        status = "converged" if not bad else (r["worst_solve_status"] or r["status"])
+        if any(x.get("machine_busy", "0") == "1" for x in rows):
+            status += " (a run on a busy machine, left out)"
+        spread = f" ({(max(t) - min(t)) / m:.0%})" if t else ""
+        print(f"| {scene} | {solver} | {threads} | {setting} | {len(rows)} | "
+              f"{'-' if m != m or bad else f'{m:.3g}{spread}'} | {'-' if ratio != ratio else f'{ratio:.2f}'} | "
+              f"{r['outer_iters']} | {r['linear_iters']} | {setup_share(d, r):.0%} | {counters(d, r)[1]} | {status} |")
+    print()
+    print("Adoption rule (a setting wins when it converged on every scene and its median is below the first "
+          f"{axis}'s on every scene the first converged on):")
+    print()
+    print(f"| solver | {axis} | converged on every scene | faster on every scene | geo. mean of the ratios | wins |")
+    print("|---|---|---|---|---:|---|")
+    for solver in solvers:
+        best = None
+        for setting in settings[1:]:
+            conv = all(not failed.get((sc, solver, setting), True) for sc in scenes)
+            ratios, faster = [], conv
+            for sc in scenes:
+                a, b = med.get((sc, solver, setting), float("nan")), med.get((sc, solver, settings[0]), float("nan"))
+                if b == b and a == a:
+                    ratios.append(a / b)
+                    faster = faster and a < b
+            g = math.exp(sum(math.log(x) for x in ratios) / len(ratios)) if ratios else float("nan")
+            wins = conv and faster
+            if wins and (best is None or g < best[1]):
+                best = (setting, g)
+            print(f"| {solver} | {setting} | {'yes' if conv else 'no'} | {'yes' if faster else 'no'} | "
+                  f"{'-' if g != g else f'{g:.2f}'} | {'yes' if wins else 'no'} |")
+        print()
+        print(f"{solver}: " + (f"adopt {axis} {best[0]} (geometric mean {best[1]:.2f} of the first's time)."
+                               if best else f"keep the first {axis} ({settings[0]})."))
+        print()
+
+
 def main(d, axis):
     cells = [r for r in read_csv(os.path.join(d, "cells.csv")) if r.get("role", "") != "reference"]
     if not cells:
         sys.exit(f"{d}/cells.csv: no cells")
     if axis not in cells[0]:
         sys.exit(f"{d}/cells.csv: no column '{axis}' (the matrix's solver_opts axis name)")
+    if any(r.get("repeat", "") not in ("", "1") for r in cells):
+        repeated(d, cells, axis)
+        return
     settings = list(dict.fromkeys(r[axis] for r in cells))
     groups = {}
     for r in cells:
