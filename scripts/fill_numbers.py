@@ -445,6 +445,43 @@ def baselines_repeat_lead(threads, what="geo"):
     return sig(math.exp(sum(math.log(x) for x in ratios) / len(ratios)), 3)
 
 
+GAMG = ("pn-gamg-pcg", "lbfgs-gamg")
+
+
+def petsc_baselines_over_hot(pick, what="geo", threads=2):
+    """results/petsc-baselines: per scene, the fastest (by median s/frame over
+    its converged, quiet runs) of the solvers `pick` accepts, over HOT's
+    median; geometric mean over the scenes, range, or the count of scenes
+    where every run of `pick`'s solvers failed ("failed")."""
+    times, tried = {}, {}
+    for r in table("petsc-baselines", "cells.csv"):
+        if r["threads"] != str(threads) or not (pick(r["solver"]) or r["solver"] == "hot"):
+            continue
+        tried.setdefault(r["scene"], set()).add(r["solver"])
+        if r["status"] == "ok" and r["worst_solve_status"] == "converged" and r.get("machine_busy", "0") != "1":
+            times.setdefault((r["scene"], r["solver"]), []).append(float(r["s_per_frame"]))
+    ratios, failed = [], 0
+    for sc in sorted(tried):
+        mine = [statistics.median(times[(sc, so)]) for so in tried[sc] if so != "hot" and (sc, so) in times]
+        if not mine:
+            failed += 1
+        if (sc, "hot") in times and mine:
+            ratios.append(min(mine) / statistics.median(times[(sc, "hot")]))
+    if what == "failed":
+        return str(failed)
+    if not ratios:
+        raise Missing(f"results/petsc-baselines: no scene with hot and the solvers asked at {threads} threads")
+    if what == "range":
+        return span(ratios, 3)
+    if what == "n":
+        return str(len(ratios))
+    return sig(math.exp(sum(math.log(x) for x in ratios) / len(ratios)), 3)
+
+
+def is_petsc_amg(solver):
+    return solver in GAMG or ":petsc:pc_type=" in solver
+
+
 def fig18_speedup(scene, solver="gast15"):
     return sig(num(one("gast15-fig18", scene=scene, solver=solver), "speedup_total"))
 
@@ -628,6 +665,17 @@ NUMBERS = {
     "base.repeat_lead_2t": lambda: baselines_repeat_lead(2),
     "base.repeat_lead_1t": lambda: baselines_repeat_lead(1),
     "mls.time_ratio_pn-pcg": lambda: mls_time_ratio("pn-pcg"),
+    "pb.date": lambda: run_date("petsc-baselines"),
+    "pb.cells": lambda: cells_ok("petsc-baselines"),
+    "pb.gamg_lead_2t": lambda: petsc_baselines_over_hot(lambda so: so in GAMG),
+    "pb.gamg_lead_2t_range": lambda: petsc_baselines_over_hot(lambda so: so in GAMG, "range"),
+    "pb.gamg_lead_2t_n": lambda: petsc_baselines_over_hot(lambda so: so in GAMG, "n"),
+    "pb.gamg_failed_scenes": lambda: petsc_baselines_over_hot(lambda so: so in GAMG, "failed"),
+    "pb.petsc_lead_2t": lambda: petsc_baselines_over_hot(is_petsc_amg),
+    "pb.petsc_lead_2t_range": lambda: petsc_baselines_over_hot(is_petsc_amg, "range"),
+    "pb.ml_lead_2t": lambda: petsc_baselines_over_hot(lambda so: so == "lbfgs-ml"),
+    "pb.hot_petsc_over_hot": lambda: petsc_baselines_over_hot(lambda so: so == "hot-petsc"),
+    "pb.hot_petsc_over_hot_range": lambda: petsc_baselines_over_hot(lambda so: so == "hot-petsc", "range"),
     "paper.cells": lambda: cells_ok("paper-scale"),
     "paper.date": lambda: run_date("paper-scale"),
     "paper.n_scenes": lambda: str(len(paper_scenes())),
