@@ -19,7 +19,7 @@ import math
 import os
 import sys
 
-from setting_table import counters, read_csv, setup_share
+from setting_table import counters, read_csv, setup_share, share
 
 ALGEBRAIC = ("pn-amg-pcg", "lbfgs-amg", "pn-ml-pcg", "lbfgs-ml", "pn-gamg-pcg", "lbfgs-gamg")
 
@@ -68,7 +68,8 @@ def repeated(d, cells):
                     row.append(f"{median(v):.3g} ({(max(v) - min(v)) / median(v):.0%})")
                 else:
                     r = median_run((sc, t, so))
-                    row.append(f"- ({r['worst_solve_status'] or r['status']})" if r else "")
+                    why = (r["status"] if r["status"] != "ok" else r["worst_solve_status"]) if r else ""
+                    row.append(f"- ({why})" if r else "")
             print(f"| {sc} | {t} | {n} | " + " | ".join(row) + " |")
 
     print("\n## Each solver's median s/frame over HOT's (range over all pairs of runs)\n")
@@ -113,10 +114,13 @@ def repeated(d, cells):
                 if not r:
                     continue
                 st = r["worst_solve_status"] or r["status"]
+                if r["status"] != "ok":
+                    st = f"{r['status']} ({st} until then)"
                 if r.get("machine_busy", "0") == "1":
                     st += " (machine busy)"
-                print(f"| {sc} | {t} | {so} | {float(r['s_per_frame'] or 'nan'):.3g} | {r['outer_iters']} | "
-                      f"{r['linear_iters']} | {r['inner_iters']} | {setup_share(d, r):.0%} | {op_complexity(d, r)} | {st} |")
+                sf = f"{float(r['s_per_frame']):.3g}" if good(r) else "-"
+                print(f"| {sc} | {t} | {so} | {sf} | {r['outer_iters']} | "
+                      f"{r['linear_iters']} | {r['inner_iters']} | {share(d, r)} | {op_complexity(d, r)} | {st} |")
 
 
 def good(r):

@@ -665,6 +665,7 @@ NUMBERS = {
     "base.repeat_lead_2t": lambda: baselines_repeat_lead(2),
     "base.repeat_lead_1t": lambda: baselines_repeat_lead(1),
     "mls.time_ratio_pn-pcg": lambda: mls_time_ratio("pn-pcg"),
+    "gamgt.date": lambda: run_date("gamg-tuning"),
     "pb.date": lambda: run_date("petsc-baselines"),
     "pb.cells": lambda: cells_ok("petsc-baselines"),
     "pb.gamg_lead_2t": lambda: petsc_baselines_over_hot(lambda so: so in GAMG),
@@ -764,13 +765,16 @@ def status_text(study):
         return (f"{study}: not a matrix study (no cells.csv or runs.csv), so its build, machine and solver definitions "
                 f"are not recorded per run and it cannot be shown current: kept for history")
     when = " to ".join(sorted(set(s["dates"]))) if s["dates"] else "date not recorded"
-    build = "+".join(s["builds"]) or "build not recorded"
+    build = "+".join(s["builds"]) or "not recorded"
     machine = "/".join(s["machines"]) or "machine not recorded"
     cores = "/".join(str(c) for c in s["cores"])
     runs = f"{s['repeats']} run{'s' if s['repeats'] != 1 else ''} per cell"
     busy = f"{s['busy_cells']} busy cells" if s["busy_recorded"] else "machine load not recorded"
     if s["current"]:
         state = "current"
+    elif not s["stale_solvers"]:
+        state = (f"{s['cells_without_run_json']} of its {s['cells']} cells without their run.json, so it cannot be "
+                 "shown current: kept for history")
     else:
         n = len(s["stale_solvers"])
         state = f"stale for {n} solver setting{'s' if n != 1 else ''} ({', '.join(s['stale_solvers'][:3])}" + \

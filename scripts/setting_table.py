@@ -49,6 +49,12 @@ def ok(r):
     return r["status"] == "ok" and r["worst_solve_status"] == "converged"
 
 
+def share(d, r):
+    """setup_share as text; '-' when the cell's steps.csv is not there"""
+    x = setup_share(d, r)
+    return "-" if x != x else f"{x:.0%}"
+
+
 def median(v):
     v = sorted(v)
     return v[len(v) // 2] if len(v) % 2 else (v[len(v) // 2 - 1] + v[len(v) // 2]) / 2
@@ -96,14 +102,14 @@ def repeated(d, cells, axis):
         spread = f" ({(max(t) - min(t)) / m:.0%})" if t else ""
         print(f"| {scene} | {solver} | {threads} | {setting} | {len(rows)} | "
               f"{'-' if m != m or bad else f'{m:.3g}{spread}'} | {'-' if ratio != ratio else f'{ratio:.2f}'} | "
-              f"{r['outer_iters']} | {r['linear_iters']} | {setup_share(d, r):.0%} | {counters(d, r)[1]} | {status} |")
+              f"{r['outer_iters']} | {r['linear_iters']} | {share(d, r)} | {counters(d, r)[1]} | {status} |")
     print()
     print("Adoption rule (a setting wins when it converged on every scene and its median is below the first "
           f"{axis}'s on every scene the first converged on):")
     print()
-    print(f"| solver | {axis} | converged on every scene | faster on every scene | geo. mean of the ratios | wins |")
-    print("|---|---|---|---|---:|---|")
     for solver in solvers:
+        print(f"| solver | {axis} | converged on every scene | faster on every scene | geo. mean of the ratios | wins |")
+        print("|---|---|---|---|---:|---|")
         best = None
         for setting in settings[1:]:
             conv = all(not failed.get((sc, solver, setting), True) for sc in scenes)

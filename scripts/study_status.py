@@ -19,7 +19,8 @@ cells' run.json files and cells.csv:
   their outer_method, inverse_approximation and solver_options, exactly as the
   C code forms it.
 
-A study is current when no solver of it is stale. Exit 0; 2 on bad arguments
+A study is current when no solver of it is stale and every cell has its
+run.json. Exit 0; 2 on bad arguments
 or when the binary cannot say a spec's definition.
 """
 import csv
@@ -151,7 +152,8 @@ def status(study, binary=DEFAULT_BINARY):
         "busy_cells": sum(unintended_busy(c) for c in cells),
         "busy_recorded": any("machine_busy" in c for c in cells),
         "stale_solvers": stale,
-        "current": not stale,
+        # a cell whose run.json is missing cannot be judged: not current
+        "current": not stale and not missing,
     }
 
 
@@ -191,7 +193,9 @@ def main(argv):
     for s in out:
         when = " to ".join(sorted(set(s["dates"]))) if s["dates"] else "?"
         busy = "%d busy" % s["busy_cells"] if s["busy_recorded"] else "load not recorded"
-        state = "current" if s["current"] else "stale for " + ", ".join(s["stale_solvers"])
+        state = "current" if s["current"] else (
+            "stale for " + ", ".join(s["stale_solvers"]) if s["stale_solvers"] else
+            "%d cells without run.json: cannot be shown current" % s["cells_without_run_json"])
         print("%-20s %4d cells, %s, build %s%s, %s, %s, repeats %d: %s" % (
             s["study"], s["cells"], when, "+".join(s["builds"]) or "?", " (modified)" if s["modified_tree"] else "",
             "/".join(s["machines"]) or "?", busy, s["repeats"], state))
