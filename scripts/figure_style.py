@@ -78,11 +78,29 @@ def solver_style(name, variants=None):
     return _C[h % len(_C)], OTHER_MARKERS[(h // 7) % len(OTHER_MARKERS)], "-"
 
 
+SHORT_LABEL = 26  # characters a solver's label may take in a figure (the tables keep the whole spec)
+
+
+def short_name(name):
+    """A solver's label in figures: the name itself when short; else the spec's
+    head (preset or OUTER:INVERSE), its first option and how many more, so
+    that 'pn:petsc:pc_type=hypre,pc_hypre_...,reuse_every=0' reads
+    'pn:petsc:pc_type=hypre +3'. The tables name the whole spec."""
+    if len(name) <= SHORT_LABEL:
+        return name
+    parts = name.split(":")
+    head = ":".join(parts[:-1]) if len(parts) > 1 else ""
+    opts = parts[-1].split(",") if len(parts) > 1 else [name]
+    label = (head + ":" if head else "") + opts[0] + (f" +{len(opts) - 1}" if len(opts) > 1 else "")
+    return label if len(label) <= SHORT_LABEL + 8 else label[:SHORT_LABEL + 5] + "..."
+
+
 def line_kwargs(name, names=None, ms=4.0, lw=1.2):
     """Keyword arguments of ax.plot for a solver (names: every solver of the figure)."""
     variants = [n for n in (names or []) if ":" in n]
     colour, marker, ls = solver_style(name, variants)
-    return {"color": colour, "marker": marker, "linestyle": ls, "markersize": ms, "linewidth": lw, "label": name,
+    return {"color": colour, "marker": marker, "linestyle": ls, "markersize": ms, "linewidth": lw,
+            "label": short_name(name),
             "markerfacecolor": "none" if ":" in name else colour}
 
 

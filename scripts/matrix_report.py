@@ -615,7 +615,7 @@ def mark_legend(drawn):
 
 def marked_label(name, marks):
     """A solver's legend or tick label with its cell's marks: 'hot (busy)'."""
-    return name + (f" ({', '.join(marks)})" if marks else "")
+    return style.short_name(name) + (f" ({', '.join(marks)})" if marks else "")
 
 
 def nice_log_ticks(lo, hi, room_in, extent=lambda t: 0.16):

@@ -228,17 +228,21 @@ static json_t *axis_name(Gen *g)
 }
 
 /* Named axes whose values are sets of the run setting `setting`: each axis a
- * list of non-empty sets (labelled by value) or an object {LABEL: set}. */
+ * list of non-empty sets (labelled by value) or an object {LABEL: set}, where
+ * a set may be empty (its label names "as the solver is", a tuning's
+ * default). */
 static json_t *named_axes(Gen *g, const char *what, const char *setting)
 {
-    json_t *set = ref(g, SETTINGS, setting);
+    json_t *set = ref(g, SETTINGS, setting), *labelled = ref(g, SETTINGS, setting);
     if (set) add(g, set, "minProperties", json_integer(1));
     json_t *axis = json_pack("{s:s, s:[{s:s, s:i, s:O}, {s:s, s:i, s:O}]}", "description",
-                             "A list of sets (each labelled by its value when it has one key, else k=v;k=v) or an "
-                             "object {LABEL: set}.",
+                             "A list of non-empty sets (each labelled by its value when it has one key, else "
+                             "k=v;k=v) or an object {LABEL: set} (there a set may be empty: the settings as they "
+                             "are).",
                              "oneOf", "type", "array", "minItems", 1, "items", set, "type", "object", "minProperties", 1,
-                             "additionalProperties", set);
+                             "additionalProperties", labelled);
     json_decref(set);
+    json_decref(labelled);
     json_t *s = object(g);
     if (!s || !axis) {
         json_decref(axis);
