@@ -168,9 +168,8 @@ static PetscErrorCode shell_setup(PC pc)
     return st ? PETSC_ERR_USER : 0;
 }
 
-/* S r: one coloured symmetric block Gauss-Seidel sweep from zero (the
- * Richardson KSP around it makes it x += S (b - A x)) */
-static PetscErrorCode shell_sgs_apply(PC pc, Vec r, Vec z)
+/* z = op(L, r) on the shell PC's level: the arrays of r and z handed to op */
+static PetscErrorCode shell_run(PC pc, Vec r, Vec z, void (*op)(const ShellLevel *, const double *, double *))
 {
     ShellLevel *L = NULL;
     const PetscScalar *rr = NULL;
@@ -179,25 +178,19 @@ static PetscErrorCode shell_sgs_apply(PC pc, Vec r, Vec z)
     if (!ierr) ierr = VecGetArrayRead(r, &rr);
     if (!ierr) ierr = VecGetArray(z, &zz);
     if (ierr) return ierr;
-    sgs_sweep(&L->A, L->dinv, L->colp, rr, zz, L->work);
+    op(L, rr, zz);
     VecRestoreArrayRead(r, &rr);
     return VecRestoreArray(z, &zz);
 }
 
+/* S r: one coloured symmetric block Gauss-Seidel sweep from zero (the
+ * Richardson KSP around it makes it x += S (b - A x)) */
+static void sgs_op(const ShellLevel *L, const double *r, double *z) { sgs_sweep(&L->A, L->dinv, L->colp, r, z, L->work); }
+static PetscErrorCode shell_sgs_apply(PC pc, Vec r, Vec z) { return shell_run(pc, r, z, sgs_op); }
+
 /* D^-1 r, the coarse CG's preconditioner */
-static PetscErrorCode shell_jacobi_apply(PC pc, Vec r, Vec z)
-{
-    ShellLevel *L = NULL;
-    const PetscScalar *rr = NULL;
-    PetscScalar *zz = NULL;
-    PetscErrorCode ierr = PCShellGetContext(pc, &L);
-    if (!ierr) ierr = VecGetArrayRead(r, &rr);
-    if (!ierr) ierr = VecGetArray(z, &zz);
-    if (ierr) return ierr;
-    vec_block_apply((size_t)L->n, L->dinv, rr, zz);
-    VecRestoreArrayRead(r, &rr);
-    return VecRestoreArray(z, &zz);
-}
+static void jacobi_op(const ShellLevel *L, const double *r, double *z) { vec_block_apply((size_t)L->n, L->dinv, r, z); }
+static PetscErrorCode shell_jacobi_apply(PC pc, Vec r, Vec z) { return shell_run(pc, r, z, jacobi_op); }
 
 /* ---- the levels ---- */
 

@@ -29,6 +29,16 @@ def algebraic(solver):
     return solver.split(":")[0] in ALGEBRAIC or any(f":petsc:pc_type={p}" in solver for p in ("hypre", "ml", "gamg"))
 
 
+def print_leads(leads, claim):
+    """Per thread count ({threads: [ratios over scenes]}): `claim` with its
+    geometric mean g, then the count and range of the scenes."""
+    for t, v in leads.items():
+        if v:
+            g = math.exp(sum(math.log(x) for x in v) / len(v))
+            print(f"\nAt {t} thread{'s' if t != '1' else ''}: " + claim.format(g=g) +
+                  f" (geometric mean over {len(v)} scenes, {min(v):.2f}-{max(v):.2f}).")
+
+
 def median(v):
     v = sorted(v)
     return v[len(v) // 2] if len(v) % 2 else (v[len(v) // 2 - 1] + v[len(v) // 2]) / 2
@@ -97,12 +107,7 @@ def repeated(d, cells):
             if best is not None:
                 leads[t].append(best)
             print(f"| {sc} | {t} | " + " | ".join(row) + " |")
-    for t in threads:
-        v = leads[t]
-        if v:
-            g = math.exp(sum(math.log(x) for x in v) / len(v))
-            print(f"\nAt {t} thread{'s' if t != '1' else ''}: the fastest algebraic multigrid of each scene takes {g:.2f}x "
-                  f"HOT's median time (geometric mean over {len(v)} scenes, {min(v):.2f}-{max(v):.2f}).")
+    print_leads(leads, "the fastest algebraic multigrid of each scene takes {g:.2f}x HOT's median time")
 
     print("\n## Iterations, setup share, operator complexity (each solver's median run)\n")
     print("| scene | threads | solver | s/frame | outer | linear | inner | setup share | op. complexity | status |")
@@ -205,12 +210,7 @@ def main(d):
             print(f"| {sc} | {t} | {a['solver'] if a else '-'} | "
                   f"{float(a['s_per_frame']) / h:.2f} | " if a else f"| {sc} | {t} | - | - | ", end="")
             print(f"{o['solver']} | {float(o['s_per_frame']) / h:.2f} |" if o else "- | - |")
-    for t in threads:
-        v = leads[t]
-        if v:
-            g = math.exp(sum(math.log(x) for x in v) / len(v))
-            print(f"\nAt {t} thread{'s' if t != '1' else ''}: the fastest algebraic multigrid takes {g:.2f}x HOT's time "
-                  f"(geometric mean over {len(v)} scenes, {min(v):.2f}-{max(v):.2f}).")
+    print_leads(leads, "the fastest algebraic multigrid takes {g:.2f}x HOT's time")
 
     print("\n## Iterations, setup share, operator complexity\n")
     print("| scene | threads | solver | s/frame | outer | linear | setup share | op. complexity | status |")

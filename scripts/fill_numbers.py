@@ -418,6 +418,11 @@ def baselines_lead(threads, what="geo"):
             ratios.append(min(alg) / t["hot"])
     if not ratios:
         raise Missing(f"results/baselines: no scene with hot and an algebraic multigrid at {threads} thread{'s' if threads != 1 else ''}")
+    return summarise(ratios, what)
+
+
+def summarise(ratios, what):
+    """Ratios over scenes as quoted: the range, the count, or the geometric mean."""
     if what == "range":
         return span(ratios, 3)
     if what == "n":
@@ -425,36 +430,13 @@ def baselines_lead(threads, what="geo"):
     return sig(math.exp(sum(math.log(x) for x in ratios) / len(ratios)), 3)
 
 
-def baselines_repeat_lead(threads, what="geo"):
-    """baselines_lead from results/baselines-repeat: each cell's median over
-    its repeats (converged, quiet runs) in place of one run."""
-    times = {}
-    for r in table("baselines-repeat", "cells.csv"):
-        if (r["threads"] == str(threads) and r["status"] == "ok" and r["worst_solve_status"] == "converged"
-                and r.get("machine_busy", "0") != "1"):
-            times.setdefault((r["scene"], r["solver"]), []).append(float(r["s_per_frame"]))
-    ratios = []
-    for sc in sorted({k[0] for k in times}):
-        alg = [statistics.median(times[(sc, s)]) for s in ALGEBRAIC if (sc, s) in times]
-        if (sc, "hot") in times and alg:
-            ratios.append(min(alg) / statistics.median(times[(sc, "hot")]))
-    if not ratios:
-        raise Missing(f"results/baselines-repeat: no scene with hot and an algebraic multigrid at {threads} threads")
-    if what == "range":
-        return span(ratios, 3)
-    return sig(math.exp(sum(math.log(x) for x in ratios) / len(ratios)), 3)
-
-
-GAMG = ("pn-gamg-pcg", "lbfgs-gamg")
-
-
-def petsc_baselines_over_hot(pick, what="geo", threads=2):
-    """results/petsc-baselines: per scene, the fastest (by median s/frame over
-    its converged, quiet runs) of the solvers `pick` accepts, over HOT's
-    median; geometric mean over the scenes, range, or the count of scenes
-    where every run of `pick`'s solvers failed ("failed")."""
+def median_lead(study, pick, what="geo", threads=2):
+    """results/STUDY with repeats: per scene, the fastest (by median s/frame
+    over its converged, quiet runs) of the solvers `pick` accepts, over HOT's
+    median; summarised over the scenes (summarise), or the count of scenes
+    where no run of `pick`'s solvers converged ("failed")."""
     times, tried = {}, {}
-    for r in table("petsc-baselines", "cells.csv"):
+    for r in table(study, "cells.csv"):
         if r["threads"] != str(threads) or not (pick(r["solver"]) or r["solver"] == "hot"):
             continue
         tried.setdefault(r["scene"], set()).add(r["solver"])
@@ -470,12 +452,22 @@ def petsc_baselines_over_hot(pick, what="geo", threads=2):
     if what == "failed":
         return str(failed)
     if not ratios:
-        raise Missing(f"results/petsc-baselines: no scene with hot and the solvers asked at {threads} threads")
-    if what == "range":
-        return span(ratios, 3)
-    if what == "n":
-        return str(len(ratios))
-    return sig(math.exp(sum(math.log(x) for x in ratios) / len(ratios)), 3)
+        raise Missing(f"results/{study}: no scene with hot and the solvers asked at {threads} threads")
+    return summarise(ratios, what)
+
+
+def baselines_repeat_lead(threads, what="geo"):
+    """baselines_lead from results/baselines-repeat: each cell's median over
+    its repeats (converged, quiet runs) in place of one run."""
+    return median_lead("baselines-repeat", lambda so: so in ALGEBRAIC, what, threads)
+
+
+GAMG = ("pn-gamg-pcg", "lbfgs-gamg")
+
+
+def petsc_baselines_over_hot(pick, what="geo", threads=2):
+    """median_lead of results/petsc-baselines."""
+    return median_lead("petsc-baselines", pick, what, threads)
 
 
 def is_petsc_amg(solver):
