@@ -45,8 +45,9 @@ PARTS = {
     "render": ("experiments/render", {"core", "scene", "solvers", "driver", "io", "run", "cli", "render"}, {"png.h"}),
     "matrix": ("experiments/matrix", {"core", "scene", "solvers", "driver", "io", "accuracy", "run", "cli", "matrix"},
                {"jansson.h", "mpi.h"}),
+    "dist": ("experiments/dist", {"core", "scene", "solvers", "driver", "io", "run", "cli", "dist"}, set()),
     "commands": ("experiments/commands", {"core", "scene", "solvers", "driver", "io", "accuracy", "run", "cli", "bench",
-                                          "render", "matrix", "commands"}, set()),
+                                          "render", "matrix", "dist", "commands"}, set()),
 }
 # third-party headers: any <...> include matching one of these needs the part's permission
 THIRD_PARTY = ["jansson.h", "png.h", "mpi.h", "HYPRE*.h", "_hypre*.h", "cholmod*.h", "ml_*.h", "Trilinos_*.h",

@@ -12,6 +12,7 @@
 #include "core/transfer.h"
 #include "experiments/bench/bench.h"
 #include "experiments/cli/run_settings.h"
+#include "experiments/dist/decompose_cmd.h"
 #include "experiments/matrix/matrix_cmd.h"
 #include "experiments/render/render_cmd.h"
 #include "experiments/run/provenance.h"
@@ -178,7 +179,7 @@ static const Command bench_command = {
 
 const Command *const cli_commands[] = {&list_command,       &run_command,           &bench_command,
                                        &render_command,     &matrix_run_command,    &matrix_report_command,
-                                       &matrix_schema_command, NULL};
+                                       &matrix_schema_command, &decompose_command, NULL};
 
 const Command *cli_command(const char *name)
 {

@@ -94,9 +94,7 @@ static int frame_listed(const char *list, int frame, int *largest)
     return found;
 }
 
-/* What a checkpoint must have been written for: the scene file's bytes, the
- * scale and every --set, in order (checkpoint.h). */
-static int scene_fingerprint(const RunConfig *cfg, const Scene *scene, uint64_t *fp)
+int run_scene_fingerprint(const RunConfig *cfg, const Scene *scene, uint64_t *fp)
 {
     FILE *f = fopen(scene->path, "rb");
     if (!f) return mpm_error(MPM_EINPUT, "%s: cannot read the scene file again", scene->path);
@@ -403,7 +401,7 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     int largest = -1;
     if (cfg->checkpoint_at) frame_listed(cfg->checkpoint_at, -1, &largest);
     if ((status = run_accuracy_bind(&acfg, scene, frames, &acc)) ||
-        ((cfg->from || cfg->checkpoint_at) && (status = scene_fingerprint(cfg, scene, &fingerprint))) ||
+        ((cfg->from || cfg->checkpoint_at) && (status = run_scene_fingerprint(cfg, scene, &fingerprint))) ||
         (cfg->from && (status = checkpoint_read(cfg->from, sim, fingerprint)))) {
         run_accuracy_free(&acc);
         session_close(&ses);

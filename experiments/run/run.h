@@ -5,6 +5,8 @@
 #ifndef MPM_RUN_H
 #define MPM_RUN_H
 
+#include <stdint.h>
+
 #include "core/scene/scene_load.h"
 #include "experiments/driver/frame_driver.h"
 #include "experiments/driver/session.h"
@@ -61,6 +63,11 @@ typedef struct {
 } RunSummary;
 
 void run_config_default(RunConfig *c);
+/* What a checkpoint must have been written for: the scene file's bytes, the
+ * scale and every --set, in order (experiments/io/checkpoint.h).
+ * MPM_EINPUT when the scene file cannot be read again. */
+int run_scene_fingerprint(const RunConfig *cfg, const Scene *scene, uint64_t *fingerprint);
+
 /* The driver session cfg asks for (scene, scale, overrides, budget,
  * solver with the user's options, threads); `list` holds the solver
  * options' storage (RUN_MAX_LIST + 1 entries). */

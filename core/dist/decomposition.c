@@ -1,0 +1,120 @@
+#include "core/dist/decomposition.h"
+
+#include <stdlib.h>
+
+#include "core/error.h"
+#include "core/radix_sort.h"
+
+#define CURVE_BITS 21
+#define CURVE_OFFSET (1 << (CURVE_BITS - 1))
+
+/* The 21 low bits of v moved to every third bit (bit i to bit 3 i). */
+static uint64_t spread_bits(uint64_t v)
+{
+    v &= 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffull;
+    v = (v | v << 16) & 0x1f0000ff0000ffull;
+    v = (v | v << 8) & 0x100f00f00f00f00full;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ull;
+    v = (v | v << 2) & 0x1249249249249249ull;
+    return v;
+}
+
+uint64_t block_curve_key(const int B[3])
+{
+    return spread_bits((uint64_t)(B[0] + CURVE_OFFSET)) << 2 | spread_bits((uint64_t)(B[1] + CURVE_OFFSET)) << 1 |
+           spread_bits((uint64_t)(B[2] + CURVE_OFFSET));
+}
+
+int decomposition_balance(const int *base, size_t n, int ranks, Decomposition *d)
+{
+    d->ranks = 0;
+    d->first_key = NULL;
+    if (ranks < 1) return mpm_error(MPM_EINPUT, "ranks: must be >= 1, got %d", ranks);
+    uint64_t *key = malloc(sizeof(uint64_t) * (n ? n : 1));
+    size_t *order = malloc(sizeof(size_t) * (n ? n : 1));
+    uint64_t *block_key = malloc(sizeof(uint64_t) * (n ? n : 1));
+    size_t *block_count = malloc(sizeof(size_t) * (n ? n : 1));
+    d->first_key = malloc(sizeof(uint64_t) * ((size_t)ranks + 1));
+    int status = MPM_OK;
+    if (!key || !order || !block_key || !block_count || !d->first_key) {
+        status = mpm_error(MPM_EINTERNAL, "out of memory: decomposing %zu particles", n);
+        goto done;
+    }
+    if (n == 0) {
+        status = mpm_error(MPM_EINPUT, "ranks: %d ranks but no particle to own", ranks);
+        goto done;
+    }
+    for (size_t k = 0; k < n; ++k) {
+        int B[3];
+        node_block_of(base + 3 * k, B);
+        key[k] = block_curve_key(B);
+    }
+    if ((status = radix_sort_u64(n, key, order))) goto done;
+
+    /* the particle blocks along the curve with their particle counts */
+    size_t nb = 0;
+    for (size_t i = 0; i < n; ++i) {
+        uint64_t k = key[order[i]];
+        if (nb && block_key[nb - 1] == k) {
+            ++block_count[nb - 1];
+        } else {
+            block_key[nb] = k;
+            block_count[nb++] = 1;
+        }
+    }
+    if ((size_t)ranks > nb) {
+        status = mpm_error(MPM_EINPUT, "ranks: %d ranks but only %zu node blocks hold particles (more ranks than "
+                                       "blocks: a rank would own no particle)",
+                           ranks, nb);
+        goto done;
+    }
+
+    /* Rank r starts at the first block whose middle lies past r n / ranks
+     * particles along the curve: each end lands within half a block of its
+     * target. Every rank keeps at least one block. */
+    d->first_key[0] = 0;
+    size_t b = 0, before = 0; /* particles in blocks [0, b) */
+    for (int r = 1; r < ranks; ++r) {
+        double target = (double)n * r / ranks;
+        size_t highest = nb - (size_t)(ranks - r); /* leaves a block to every later rank */
+        before += block_count[b++];                   /* rank r - 1 keeps block b */
+        while (b < highest && before + 0.5 * block_count[b] < target) before += block_count[b++];
+        d->first_key[r] = block_key[b];
+    }
+    d->first_key[ranks] = UINT64_MAX;
+    d->ranks = ranks;
+done:
+    free(key);
+    free(order);
+    free(block_key);
+    free(block_count);
+    if (status) decomposition_free(d);
+    return status;
+}
+
+int decomposition_owner(const Decomposition *d, const int B[3])
+{
+    uint64_t k = block_curve_key(B);
+    int lo = 0, hi = d->ranks - 1; /* the last r with first_key[r] <= k */
+    while (lo < hi) {
+        int mid = (lo + hi + 1) / 2;
+        if (d->first_key[mid] <= k) lo = mid;
+        else hi = mid - 1;
+    }
+    return lo;
+}
+
+int decomposition_node_owner(const Decomposition *d, const int c[3])
+{
+    int B[3];
+    node_block_of(c, B);
+    return decomposition_owner(d, B);
+}
+
+void decomposition_free(Decomposition *d)
+{
+    free(d->first_key);
+    d->first_key = NULL;
+    d->ranks = 0;
+}
