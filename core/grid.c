@@ -167,7 +167,9 @@ static int cmp_u64(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-int grid_build(Grid *g, Stencils *st, Particles *p, double dx)
+int grid_build(Grid *g, Stencils *st, Particles *p, double dx) { return grid_build_with_nodes(g, st, p, dx, NULL, 0); }
+
+int grid_build_with_nodes(Grid *g, Stencils *st, Particles *p, double dx, const int *extra, int n_extra)
 {
     int status;
     size_t np = p->n;
@@ -196,8 +198,8 @@ int grid_build(Grid *g, Stencils *st, Particles *p, double dx)
     }
 
     /* Blocks touched: each particle block b touches node blocks b + {0,1}^3. */
-    if ((status = ensure_blocks(g, 8 * npb + 8))) return status;
-    if ((status = reset_hash(g, 8 * npb + 8))) return status;
+    if ((status = ensure_blocks(g, 8 * npb + 8 + n_extra))) return status;
+    if ((status = reset_hash(g, 8 * npb + 8 + n_extra))) return status;
     g->n_blocks = 0;
     int *pb_blocks = malloc(sizeof(int) * 8 * (size_t)(npb > 0 ? npb : 1));
     if (!pb_blocks) return mpm_error(MPM_EINTERNAL, "out of memory: grid build");
@@ -231,6 +233,11 @@ int grid_build(Grid *g, Stencils *st, Particles *p, double dx)
         }
     }
     free(pb_blocks);
+    for (int e = 0; e < n_extra; ++e) { /* nodes no particle here reaches (a distributed run's owned nodes) */
+        const int *c = extra + 3 * (size_t)e;
+        int b = block_insert(g, pack_block(floor_div_pow2(c[0], 2), floor_div_pow2(c[1], 2), floor_div_pow2(c[2], 2)));
+        g->block_mask[b] |= 1ull << (((c[0] & 3) << 4) | ((c[1] & 3) << 2) | (c[2] & 3));
+    }
 
     /* Keep non-empty blocks, sorted by key; number the nodes. */
     int nb = 0;

@@ -83,6 +83,12 @@ static inline void stencil_weights(const Stencils *st, size_t k, double w[27], d
  * and fills the stencils. Allocates only when sizes grow. */
 int grid_build(Grid *g, Stencils *st, Particles *p, double dx);
 
+/* grid_build, with the n_extra nodes at the integer coordinates `extra`
+ * (3 ints each) active too, whether a particle reaches them or not: a
+ * distributed run's rank holds the nodes it owns that only other ranks'
+ * particles reach (core/dist/dist_grid.h). */
+int grid_build_with_nodes(Grid *g, Stencils *st, Particles *p, double dx, const int *extra, int n_extra);
+
 /* MLS-MPM (SPEC 9; Hu et al. 2018 supplement eq. 5-10): replaces each
  * weight gradient grad w_ip by w_ip D_p^-1 (x_i - x_p), D_p = dx^2/4 I for
  * the quadratic B-spline, so the force, the F update and the incremental
