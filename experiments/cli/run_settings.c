@@ -88,6 +88,12 @@ const Option run_settings[] = {
     {"--from", NULL, "FILE", OPT_TEXT, 0, 0, "a checkpoint file", NULL, F(from), 0, NULL, 0,
      "continue from a checkpoint (--checkpoint-at) of the same scene, scale and --set: the steps from its frame on "
      "are those of the run that wrote it, bit for bit; --frames is still the last frame"},
+    {"--sample-from", NULL, "DIR", OPT_TEXT, 0, 0, "a checkpoints folder", NULL, F(sample_from), 0, NULL, 0,
+     "with --sample-frames: the folder of a run's checkpoints (its OUT/checkpoints)"},
+    {"--sample-frames", NULL, "F,F,...", OPT_TEXT, 0, 0, "increasing frame numbers", NULL, F(sample_frames), 0,
+     run_check_sample_frames, 0,
+     "time these frames only, each alone from its checkpoint in --sample-from, so that runs of different "
+     "solvers are timed on the same states (frames.csv: one row each; a matrix reference's sample_frames)"},
     {"--max-particles", NULL, "N", OPT_SIZE, 1, 1e12, "a whole number of particles", NULL, F(max_particles), 0, NULL,
      0, "refuse a scene above N particles (default: physical memory / 16 KiB)"},
     {"--quiet", NULL, NULL, OPT_SWITCH, 0, 0, NULL, NULL, F(quiet), 0, NULL, 0, "no per-frame table on stdout"},

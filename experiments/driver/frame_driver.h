@@ -43,6 +43,13 @@ typedef struct {
 
 typedef struct {
     int frames;              /* simulate until sim->frame reaches it */
+    /* n_samples > 0: instead, drive only the frames sample_frames[0..n)
+     * (increasing), each alone: restore() puts the state at the start of
+     * frame k into sim (a checkpoint), then frame k runs; `frames` is not
+     * used. The time budget and the failure policy span all of them. */
+    const int *sample_frames;
+    int n_samples;
+    int (*restore)(void *ctx, Simulation *sim, int frame);
     FailurePolicy on_failure;
     int progress;            /* show the progress line (on a terminal only, never in CI or a pipe) */
     double max_step_s;       /* > 0: each solve's deadline (--max-step-seconds) */

@@ -62,21 +62,49 @@ void run_session_config(const RunConfig *cfg, SessionConfig *sc, const char **li
                           .solver_opts = list, .n_solver_opts = n, .threads = cfg->threads};
 }
 
-int run_check_frame_list(const char *text)
+/* Frame numbers >= 0 separated by commas (increasing when asked): the
+ * value of `flag`. */
+static int check_frame_list(const char *flag, const char *text, int increasing)
 {
     int n = 0;
+    long last = -1;
     const char *c = text;
     while (*c) {
         char *end;
         long f = strtol(c, &end, 10);
         if (end == c || f < 0 || f > 100000000 || (*end && *end != ',') || ++n > RUN_MAX_LIST)
-            return mpm_error(MPM_EINPUT, "--checkpoint-at '%s': expected at most %d frame numbers >= 0 separated by commas",
+            return mpm_error(MPM_EINPUT, "%s '%s': expected at most %d frame numbers >= 0 separated by commas", flag,
                              text, RUN_MAX_LIST);
+        if (increasing && f <= last)
+            return mpm_error(MPM_EINPUT, "%s '%s': frame %ld after %ld (expected increasing frame numbers)", flag, text,
+                             f, last);
+        last = f;
         c = *end ? end + 1 : end;
-        if (*end && !*c) return mpm_error(MPM_EINPUT, "--checkpoint-at '%s': a comma at the end", text);
+        if (*end && !*c) return mpm_error(MPM_EINPUT, "%s '%s': a comma at the end", flag, text);
     }
-    if (!n) return mpm_error(MPM_EINPUT, "--checkpoint-at '': expected frame numbers");
+    if (!n) return mpm_error(MPM_EINPUT, "%s '': expected frame numbers", flag);
     return MPM_OK;
+}
+
+int run_check_frame_list(const char *text) { return check_frame_list("--checkpoint-at", text, 0); }
+
+int run_check_sample_frames(const char *text) { return check_frame_list("--sample-frames", text, 1); }
+
+/* The sampled frames of a checked --sample-frames text; their count. */
+static int sample_list(const char *text, int *frames)
+{
+    int n = 0;
+    for (const char *c = text; c && *c && n < RUN_MAX_LIST;) {
+        char *end;
+        frames[n++] = (int)strtol(c, &end, 10);
+        c = *end ? end + 1 : end;
+    }
+    return n;
+}
+
+static void sample_path(const char *dir, int frame, char *path, size_t n)
+{
+    snprintf(path, n, "%s/frame_%04d.ckpt", dir, frame);
 }
 
 /* Is `frame` in the (checked) list, and the largest listed frame. */
@@ -200,6 +228,33 @@ int run_config_check(const RunConfig *cfg)
     AccuracyConfig acc = accuracy_config(cfg);
     if ((st = run_accuracy_check(&acc))) return st;
     if (cfg->checkpoint_at && (st = run_check_frame_list(cfg->checkpoint_at))) return st;
+    if (!cfg->sample_from != !cfg->sample_frames)
+        return mpm_error(MPM_EINPUT, "%s: needs %s", cfg->sample_from ? "--sample-from" : "--sample-frames",
+                         cfg->sample_from ? "--sample-frames" : "--sample-from");
+    if (cfg->sample_frames) {
+        /* each sampled frame runs alone: nothing that follows one trajectory */
+        const char *other = cfg->from             ? "--from"
+                            : cfg->checkpoint_at  ? "--checkpoint-at"
+                            : cfg->dt_from        ? "--dt-from"
+                            : cfg->trajectory_ref ? "--trajectory-ref"
+                            : cfg->trajectory     ? "--trajectory"
+                            : cfg->vtk_dir        ? "--vtk"
+                            : cfg->particles_dir  ? "--particles"
+                            : cfg->frames > 0     ? "--frames"
+                                                  : NULL;
+        if (other)
+            return mpm_error(MPM_EINPUT, "--sample-frames: not with %s (each sampled frame runs alone from its checkpoint)",
+                             other);
+        int frames[RUN_MAX_LIST], n = sample_list(cfg->sample_frames, frames);
+        for (int i = 0; i < n; ++i) {
+            char path[1200];
+            int frame;
+            sample_path(cfg->sample_from, frames[i], path, sizeof path);
+            if ((st = checkpoint_frame(path, &frame))) return mpm_error_context(st, "--sample-frames %d", frames[i]);
+            if (frame != frames[i])
+                return mpm_error(MPM_EINPUT, "--sample-frames %d: %s starts at frame %d", frames[i], path, frame);
+        }
+    }
     if (cfg->from) {
         /* the replays and comparisons count frames from the start of the animation */
         if (cfg->dt_from || cfg->trajectory_ref || cfg->trajectory)
@@ -235,6 +290,15 @@ typedef struct {
     const char *out_dir;
     uint64_t fingerprint;      /* the scene's, for checkpoints */
 } RunOutput;
+
+/* --sample-frames: the state at the start of a sampled frame, from its checkpoint */
+static int restore_sample(void *ctx, Simulation *sim, int frame)
+{
+    const RunOutput *o = ctx;
+    char path[1200];
+    sample_path(o->cfg->sample_from, frame, path, sizeof path);
+    return checkpoint_read(path, sim, o->fingerprint);
+}
 
 static void write_iteration(void *ctx, int frame, int step, int iter, double elapsed, double residual, double energy)
 {
@@ -347,9 +411,12 @@ static void write_run_json(const char *dir, const RunConfig *cfg, const Scene *s
     if (root) json_object_set_new(root, "accuracy", (json_t *)run_accuracy_json(&ac, acc));
     if (root) /* where the run started and where it leaves checkpoints */
         json_object_set_new(root, "checkpoints",
-                            json_pack("{s:o, s:i, s:o}", "from", cfg->from ? json_string(cfg->from) : json_null(),
+                            json_pack("{s:o, s:i, s:o, s:o, s:o}", "from", cfg->from ? json_string(cfg->from) : json_null(),
                                       "first_frame", first_frame, "at",
-                                      cfg->checkpoint_at ? json_string(cfg->checkpoint_at) : json_null()));
+                                      cfg->checkpoint_at ? json_string(cfg->checkpoint_at) : json_null(),
+                                      "sample_from", cfg->sample_from ? json_string(cfg->sample_from) : json_null(),
+                                      "sample_frames",
+                                      cfg->sample_frames ? json_string(cfg->sample_frames) : json_null()));
     if (root) json_object_set_new(root, "startup_s", json_real(library_startup_seconds()));
     /* threads each phase ran on: the inverse approximation's library may
      * not use the run's OpenMP team (hypre: 1 in Debian's build) */
@@ -396,13 +463,25 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
         return status;
     }
     int frames = cfg->frames > 0 ? cfg->frames : scene->frames;
-    /* the reference runs match this scene: checked before the output folder is made */
+    int samples[RUN_MAX_LIST], n_samples = cfg->sample_frames ? sample_list(cfg->sample_frames, samples) : 0;
+    if (n_samples) frames = samples[n_samples - 1] + 1; /* the last frame the run reaches */
+    /* the reference runs and checkpoints match this scene: checked before the output folder is made */
     uint64_t fingerprint = 0;
     int largest = -1;
     if (cfg->checkpoint_at) frame_listed(cfg->checkpoint_at, -1, &largest);
     if ((status = run_accuracy_bind(&acfg, scene, frames, &acc)) ||
-        ((cfg->from || cfg->checkpoint_at) && (status = run_scene_fingerprint(cfg, scene, &fingerprint))) ||
+        ((cfg->from || cfg->checkpoint_at || n_samples) && (status = run_scene_fingerprint(cfg, scene, &fingerprint))) ||
         (cfg->from && (status = checkpoint_read(cfg->from, sim, fingerprint)))) {
+        run_accuracy_free(&acc);
+        session_close(&ses);
+        return status;
+    }
+    for (int i = 0; i < n_samples && !status; ++i) { /* every sampled state is of this scene */
+        char path[1200];
+        sample_path(cfg->sample_from, samples[i], path, sizeof path);
+        status = checkpoint_read(path, sim, fingerprint);
+    }
+    if (status) {
         run_accuracy_free(&acc);
         session_close(&ses);
         return status;
@@ -435,7 +514,8 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     if (!(frames_csv = open_in(out_dir, "frames.csv", &status))) goto done;
     if (cfg->history && !(iters_csv = open_in(out_dir, "iters.csv", &status))) goto done;
     if ((status = run_accuracy_open(&acc, out_dir, scene))) goto done;
-    write_run_json(out_dir, cfg, scene, solver, &set, &acc, frames, sim->frame, threads, &status);
+    write_run_json(out_dir, cfg, scene, solver, &set, &acc, frames, n_samples ? samples[0] : sim->frame, threads,
+                   &status);
     if (status) goto done;
     fprintf(steps_csv, "scene,solver,frame,step,t,dt,particles,active_nodes,hessian_blocks,outer_iters,linear_iters,"
                        "ls_evals,residual,status,wall_s,p2g_s,assemble_s,setup_s,solve_s,linesearch_s,g2p_s,threads,"
@@ -462,6 +542,9 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     RunOutput out = {cfg,     scene,   solver,      &acc, steps_csv, frames_csv, iters_csv, threads,
                      cfg->vtk_dir ? &vtk : NULL, out_dir, fingerprint};
     FrameDriver driver = {.frames = frames,
+                          .sample_frames = samples,
+                          .n_samples = n_samples,
+                          .restore = restore_sample,
                           .on_failure = cfg->on_failure,
                           .progress = 1,
                           .max_step_s = cfg->max_step_s,

@@ -54,6 +54,8 @@ typedef struct {
     /* checkpoints (experiments/io/checkpoint.h; NULL = none) */
     const char *checkpoint_at;  /* --checkpoint-at F,F,...: OUT/checkpoints/frame_NNNN.ckpt at those frames' starts */
     const char *from;           /* --from FILE: continue from a checkpoint, bit for bit */
+    const char *sample_from;    /* --sample-from DIR: a run's checkpoints folder */
+    const char *sample_frames;  /* --sample-frames F,F,...: time each frame alone from its checkpoint in sample_from */
 } RunConfig;
 
 typedef struct {
@@ -79,6 +81,8 @@ int run_config_check(const RunConfig *cfg);
 /* --checkpoint-at's value: frame numbers >= 0 separated by commas (at most
  * RUN_MAX_LIST); MPM_EINPUT naming the flag and the text otherwise. */
 int run_check_frame_list(const char *text);
+/* --sample-frames' value: increasing frame numbers >= 0 separated by commas. */
+int run_check_sample_frames(const char *text);
 /* The solve settings cfg asks for. */
 void run_solve_settings(const RunConfig *cfg, SolveSettings *set);
 int run_simulation(const RunConfig *cfg, RunSummary *sum);
