@@ -1477,6 +1477,11 @@ def main(argv, figure_hook=None):
                      + (f", {repeat} per cell" if repeat > 1 else "") + f", {len(cases)} cases; baseline solver: "
                      f"{baseline or 'none'}. Times are over each cell's timed window (frames from first_timed_frame "
                      "on) and over the frames it finished.\n")
+    sampled = sorted({(c.row.get("scene", ""), c.row.get("sample_frames", "")) for c in runs if c.row.get("sample_frames")})
+    if sampled:
+        md_detail.append("Sampled frames (each timed alone from a checkpoint its scene's reference run wrote, so every "
+                         "solver ran on the same states; a cell's time is over these frames, its max per frame the "
+                         "slowest of them): " + "; ".join(f"{s}: {f}" for s, f in sampled) + ".\n")
     constant = [k for k in cols if len({c.row.get(k, "") for c in cells}) == 1]
     if cells and constant:
         md_detail.append("Same in every cell: " + ", ".join(f"{k}={cells[0].row.get(k, '')}" for k in constant) + ".\n")

@@ -177,7 +177,7 @@ static int in_id(int k, const MatrixCell *c)
  * the table (in_id) and the matrix's first_timed_frame, reference and repeat. */
 static int cell_identify(MatrixCell *c)
 {
-    Entry e[RUN_SETTINGS_MAX + 3];
+    Entry e[RUN_SETTINGS_MAX + 4];
     int n = 0;
     for (int k = 0; k < run_settings_count; ++k) {
         if (!in_id(k, c)) continue;
@@ -192,6 +192,11 @@ static int cell_identify(MatrixCell *c)
         e[n].key = "reference";
         e[n].value = (Text){NULL, 0, 0, 0};
         text_string(&e[n++].value, c->ref_id);
+    }
+    if (c->sample_frames) {
+        e[n].key = "sample_frames";
+        e[n].value = (Text){NULL, 0, 0, 0};
+        text_string(&e[n++].value, c->sample_frames);
     }
     if (c->repeat > 1) { /* the first run keeps the id of a matrix without repeat */
         e[n].key = "repeat";
@@ -379,8 +384,17 @@ static int build_reference(const MatrixReference *r, const MatrixCell *c, Matrix
     apply(ref, run_setting_index("solver"), &v, r->solver_origin);
     v.d = r->eps;
     apply(ref, run_setting_index("eps"), &v, r->origin);
-    v.i = 1;
-    apply(ref, run_setting_index("trajectory"), &v, r->origin);
+    if (r->sample_frames) { /* checkpoints at the sampled frames, up to the last one's start */
+        const char *last = strrchr(r->sample_frames, ',');
+        v.i = atoi(last ? last + 1 : r->sample_frames) + 1;
+        apply(ref, run_setting_index("frames"), &v, r->origin);
+        ref->run.checkpoint_at = r->sample_frames;
+        ref->sample_frames = r->sample_frames;
+        ref->first_timed_frame = 0;
+    } else {
+        v.i = 1;
+        apply(ref, run_setting_index("trajectory"), &v, r->origin);
+    }
     ref->run.error_ref = NULL;
     ref->given &= ~(1ull << run_setting_index("error_ref"));
     ref->run.history = 0;
@@ -516,6 +530,13 @@ int matrix_expand(const Matrix *m, MatrixCells *out)
             int j = st ? -1 : find_same(refs, n_refs, rc);
             if (j == -2) st = MPM_EINTERNAL;
             if (!st) snprintf(c->ref_id, sizeof c->ref_id, "%s", rc->id);
+            if (!st && r->sample_frames) { /* the cell times the reference's checkpoints */
+                if (c->first_timed_frame > 0)
+                    st = mpm_error(MPM_EINPUT, "%s: %s.sample_frames: not with first_timed_frame %d (every sampled "
+                                               "frame is timed)",
+                                   m->base, r->origin, c->first_timed_frame);
+                c->sample_frames = r->sample_frames;
+            }
             if (!st && j < 0) n_refs++;
             else cell_release(rc);
         }
@@ -573,12 +594,15 @@ void matrix_cell_describe(const Matrix *m, const MatrixCell *c, char *out, size_
     matrix_format_number(c->run.scale, scale, sizeof scale);
     size_t len = (size_t)snprintf(out, n, "eps=%s scale=%s", eps, scale);
     if (c->run.threads && len < n) len += (size_t)snprintf(out + len, n - len, " threads=%d", c->run.threads);
-    if (c->run.frames && len < n) len += (size_t)snprintf(out + len, n - len, " frames=%d", c->run.frames);
+    if (c->run.frames && !(c->sample_frames && !c->is_reference) && len < n)
+        len += (size_t)snprintf(out + len, n - len, " frames=%d", c->run.frames);
     if (c->first_timed_frame && len < n) len += (size_t)snprintf(out + len, n - len, " timed-from=%d", c->first_timed_frame);
     if (c->run.error_ref && len < n) len += (size_t)snprintf(out + len, n - len, " error_ref=%s", c->run.error_ref);
     for (int a = 0; a < m->n_named && len < n; ++a)
         len += (size_t)snprintf(out + len, n - len, " %s=%s", m->named[a].name, m->named[a].values[c->value[a]].label);
     if (c->repeat > 1 && len < n) len += (size_t)snprintf(out + len, n - len, " repeat=%d", c->repeat);
+    if (c->sample_frames && len < n)
+        len += (size_t)snprintf(out + len, n - len, c->is_reference ? " checkpoints=%s" : " sampled=%s", c->sample_frames);
     if (c->is_reference && len < n) len += (size_t)snprintf(out + len, n - len, " (reference run)");
     else if (c->ref_id[0] && len < n) len += (size_t)snprintf(out + len, n - len, " reference=%s", c->ref_id);
 }
@@ -611,7 +635,17 @@ int matrix_cell_config(const Matrix *m, const MatrixCell *c, const char *out_dir
                              c->ref_id)
                   : snprintf(texts->reference, sizeof texts->reference, "%s", c->ref_id);
         if (w < 0 || (size_t)w >= sizeof texts->reference) return mpm_error(MPM_EINPUT, "cell command line too long");
-        cfg->dt_from = cfg->trajectory_ref = texts->reference;
+        if (c->sample_frames) { /* the reference's checkpoints, each sampled frame alone */
+            size_t len = strlen(texts->reference);
+            if (len + sizeof "/checkpoints" > sizeof texts->reference)
+                return mpm_error(MPM_EINPUT, "cell command line too long");
+            memcpy(texts->reference + len, "/checkpoints", sizeof "/checkpoints");
+            cfg->sample_from = texts->reference;
+            cfg->sample_frames = c->sample_frames;
+            cfg->frames = 0;
+        } else {
+            cfg->dt_from = cfg->trajectory_ref = texts->reference;
+        }
     }
     cfg->quiet = 1;
     cfg->out_dir = out_dir;

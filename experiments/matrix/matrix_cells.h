@@ -35,6 +35,8 @@ typedef struct {
     int is_reference;            /* a reference run other cells depend on */
     int ref;                     /* index of this cell's reference cell, -1 = none */
     char ref_id[16];             /* its id ("" = none) */
+    const char *sample_frames;   /* its reference's sample_frames (matrix_file.h): the reference writes
+                                    checkpoints at them, the cell times them (the matrix's pool; NULL: none) */
     int repeat;                  /* 1..matrix repeat: which run of the same settings */
 } MatrixCell;
 

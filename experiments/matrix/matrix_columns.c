@@ -19,6 +19,7 @@ const MatrixColumnInfo matrix_columns[MATRIX_COLS] = {
     [MATRIX_COL_REPEAT] = {"repeat", MATRIX_COL_WITH_REPEAT},
     [MATRIX_COL_ROLE] = {"role", MATRIX_COL_WITH_REFERENCES},
     [MATRIX_COL_REFERENCE] = {"reference", MATRIX_COL_WITH_REFERENCES},
+    [MATRIX_COL_SAMPLE_FRAMES] = {"sample_frames", MATRIX_COL_WITH_SAMPLES},
     [MATRIX_COL_SET] = {"set", MATRIX_COL_ALWAYS},
     [MATRIX_COL_SOLVER_OPTS] = {"solver_opts", MATRIX_COL_ALWAYS},
 };

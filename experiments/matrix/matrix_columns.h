@@ -22,6 +22,7 @@ typedef enum {
     MATRIX_COL_REPEAT,
     MATRIX_COL_ROLE,              /* cell | reference */
     MATRIX_COL_REFERENCE,         /* the reference cell's id */
+    MATRIX_COL_SAMPLE_FRAMES,     /* the frames a sampled cell timed (its reference wrote them), else empty */
     MATRIX_COL_SET,               /* the merged k=v;k=v */
     MATRIX_COL_SOLVER_OPTS,
     MATRIX_COLS
@@ -32,7 +33,8 @@ typedef enum {
     MATRIX_COL_ALWAYS,
     MATRIX_COL_WITH_ERROR_REF,  /* error_ref is given somewhere */
     MATRIX_COL_WITH_REPEAT,     /* repeat > 1 */
-    MATRIX_COL_WITH_REFERENCES  /* some cell has a reference run */
+    MATRIX_COL_WITH_REFERENCES, /* some cell has a reference run */
+    MATRIX_COL_WITH_SAMPLES     /* some reference run has sample_frames */
 } MatrixColumnWhen;
 
 typedef struct {

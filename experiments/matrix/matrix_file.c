@@ -15,6 +15,7 @@
 #include "experiments/driver/registry.h"
 #include "experiments/matrix/matrix_columns.h"
 #include "experiments/matrix/matrix_keys.h"
+#include "experiments/run/run.h"
 
 void matrix_format_number(double v, char *out, size_t n)
 {
@@ -288,6 +289,13 @@ static int get_reference(Matrix *m, json_t *v, const char *path, int allow_false
     json_t *sv = json_object_get(v, "set");
     sj_path(p, sizeof p, path, "set");
     if (sv && (st = get_kv(m, sv, p, MATRIX_SET, &r->set))) return st;
+    json_t *sf = json_object_get(v, "sample_frames");
+    sj_path(p, sizeof p, path, "sample_frames");
+    if (sf) {
+        if (!json_is_string(sf)) return bad_value(m, p, sf, "a text of increasing frame numbers \"F,F,...\"");
+        if ((st = run_check_sample_frames(json_string_value(sf)))) return mpm_error_context(st, "%s: %s", m->base, p);
+        if ((st = keep(m, json_string_value(sf), &r->sample_frames))) return st;
+    }
     r->has = 1;
     return MPM_OK;
 }
@@ -620,12 +628,14 @@ static int get_top(Matrix *m)
     if ((v = json_object_get(root, "reference")) && (st = get_reference(m, v, "reference", 0, &m->reference)))
         return st;
     m->has_references = m->reference.has;
+    m->has_samples = m->reference.has && m->reference.sample_frames;
     int ke = run_setting_index("error_ref");
     m->uses_error_ref = (m->defaults.given >> ke & 1) || m->axis[ke].n > 0;
     for (int i = 0; i < m->n_per_scene; ++i) {
         const MatrixSettings *ps = &m->per_scene[i].s;
         m->uses_error_ref |= ps->given >> ke & 1;
         m->has_references |= ps->has_reference && ps->reference.has;
+        m->has_samples |= ps->has_reference && ps->reference.has && ps->reference.sample_frames;
     }
     if ((v = json_object_get(root, "include"))) {
         if ((st = get_rules(m, v, "include"))) return st;

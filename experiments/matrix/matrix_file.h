@@ -57,6 +57,7 @@ typedef struct {
     double eps;
     MatrixKvList solver_opts;
     MatrixKvList set;         /* --set overrides on top of the cell's (e.g. another transfer) */
+    const char *sample_frames; /* "F,F,...": a checkpoint run for sampled cells (in the text pool); NULL: none */
     char origin[200];         /* where it was given, for messages */
     const char *solver_origin;
 } MatrixReference;
@@ -108,6 +109,7 @@ typedef struct {
     int repeat;                   /* runs of every timed cell (>= 1) */
     MatrixReference reference;    /* top-level "reference" */
     int has_references;           /* some scene has a reference run */
+    int has_samples;              /* some reference run has sample_frames */
     int uses_error_ref;           /* error_ref given anywhere: a cells.csv column */
     json_t *root;                 /* the parsed file */
     char **pool;                  /* the texts the settings point to */

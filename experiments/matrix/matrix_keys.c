@@ -42,6 +42,9 @@ const MatrixKey matrix_keys[] = {
      "its solver options, replacing the cell's"},
     {MATRIX_AT_REFERENCE, "set", MATRIX_KEY_SETTING, 0, 0, 0, "set", NULL,
      "--set overrides replacing or extending the cell's"},
+    {MATRIX_AT_REFERENCE, "sample_frames", MATRIX_KEY_TEXT, 0, 0, 0, NULL, NULL,
+     "\"F,F,...\", increasing frame numbers: the reference run writes checkpoints at these frames instead of a "
+     "trajectory, and every cell of its scene times each of these frames alone from them (run --sample-frames)"},
 
     {MATRIX_AT_REPORT, "mg_levels", MATRIX_KEY_BOOL, 0, 0, 0, NULL, NULL,
      "also tabulate mg_levels.csv, the multigrid levels (HOT Fig. 8)"},

@@ -51,6 +51,8 @@ int matrix_results_has(const Matrix *m, MatrixColumn k)
         return m->repeat > 1;
     case MATRIX_COL_WITH_REFERENCES:
         return m->has_references;
+    case MATRIX_COL_WITH_SAMPLES:
+        return m->has_samples;
     case MATRIX_COL_ALWAYS:
         break;
     }
@@ -123,6 +125,9 @@ void matrix_results_field(const MatrixCell *c, const CellMeasure *x, MatrixColum
         break;
     case MATRIX_COL_REFERENCE:
         snprintf(out, cap, "%s", c->ref_id);
+        break;
+    case MATRIX_COL_SAMPLE_FRAMES:
+        snprintf(out, cap, "%s", c->sample_frames && !c->is_reference ? c->sample_frames : "");
         break;
     case MATRIX_COL_SET:
         kv_join(c->set, c->n_set, out, cap);

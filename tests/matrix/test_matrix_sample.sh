@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# A matrix reference with sample_frames (issue 28): the scene's reference
+# run writes checkpoints at those frames (run --checkpoint-at) instead of a
+# trajectory and runs first; every cell of the scene times each sampled
+# frame alone from them (run --sample-from/--sample-frames): its frames.csv
+# has exactly those frames, the writing solver's sampled rows repeat the
+# reference run's, cells.csv gets a sample_frames column and the report
+# says which frames were sampled; other scenes run as before; a second
+# `matrix run` has nothing to do; the sampled frames are part of the ids;
+# a bad list, or first_timed_frame beside sample_frames, is a one-line
+# error, exit 2.
+. "$(dirname "$0")/../common/shell_harness.sh"
+cat >"$tmp/m.json" <<'EOF2'
+{"name": "sampled",
+ "defaults": {"threads": 2, "scale": 5},
+ "axes": {"scene": ["sauce", "bar3"], "solver": ["pn-pcg", "hot"]},
+ "scenes": {"sauce": {"reference": {"solver": "pn-pcg", "eps": 1e-7, "sample_frames": "1,4,6"}},
+            "bar3": {"frames": 1}}}
+EOF2
+"$bin" matrix run "$tmp/m.json" --out "$tmp/r" >"$tmp/run.txt" 2>&1
+check "matrix run: exit 0" test $? -eq 0
+check "the reference first, writing checkpoints" bash -c "sed -n 2p '$tmp/run.txt' | grep -q 'sauce/pn-pcg .*frames=7 checkpoints=1,4,6 (reference run): ok'"
+ref=$(sed -n 2p "$tmp/run.txt" | sed 's/^\[[0-9]*\/[0-9]*\] //' | cut -d' ' -f1)
+check "its checkpoints exist" test -f "$tmp/r/cells/$ref/checkpoints/frame_0004.ckpt"
+check "two sampled cells name it" test "$(grep -c "sampled=1,4,6 reference=$ref: ok" "$tmp/run.txt")" -eq 2
+python3 - "$tmp/r" "$ref" >"$tmp/cmp" 2>&1 <<'PY'
+import csv, sys
+root, ref = sys.argv[1], sys.argv[2]
+cells = list(csv.DictReader(open(f"{root}/cells.csv")))
+sampled = [c for c in cells if c["reference"] == ref]
+assert len(sampled) == 2 and all(c["sample_frames"] == "1,4,6" for c in sampled), sampled
+assert all(c["sample_frames"] == "" for c in cells if c["scene"] == "bar3"), "bar3 is not sampled"
+for c in sampled:
+    frames = [r["frame"] for r in csv.DictReader(open(f"{root}/cells/{c['id']}/frames.csv"))]
+    assert frames == ["1", "4", "6"], (c["solver"], frames)
+    assert c["timed_frames"] == "3", c["timed_frames"]
+same = next(c for c in sampled if c["solver"] == "pn-pcg")
+full = [r for r in csv.DictReader(open(f"{root}/cells/{ref}/steps.csv")) if r["frame"] in ("1", "4", "6")]
+part = list(csv.DictReader(open(f"{root}/cells/{same['id']}/steps.csv")))
+keys = [k for k in part[0] if not k.endswith("_s") and k != "threads"]
+assert len(full) == len(part) > 0 and all(a[k] == b[k] for a, b in zip(full, part) for k in keys), "rows differ"
+print("ok")
+PY
+check "sampled cells: the frames, the column, the writing solver's rows ($(tail -1 "$tmp/cmp"))" grep -qx ok "$tmp/cmp"
+"$bin" matrix report "$tmp/r" >/dev/null 2>&1
+check "the report names the sampled frames" grep -q "Sampled frames .*sauce: 1,4,6" "$tmp/r/report.md"
+"$bin" matrix run "$tmp/m.json" --out "$tmp/r" >"$tmp/again.txt" 2>&1
+check "resume: nothing left" grep -q "0 to run" "$tmp/again.txt"
+
+sed 's/"1,4,6"/"1,5"/' "$tmp/m.json" >"$tmp/m2.json"
+"$bin" matrix run "$tmp/m.json" --out "$tmp/d1" --dry-run >"$tmp/dry1.txt"
+"$bin" matrix run "$tmp/m2.json" --out "$tmp/d2" --dry-run >"$tmp/dry2.txt"
+sauce_ids() { awk '$3 ~ /^sauce\// {print $1}' "$1" | sort; }
+bar3_ids() { awk '$3 ~ /^bar3\// {print $1}' "$1" | sort; }
+check "other sampled frames: every sauce id changes ($(sauce_ids "$tmp/dry2.txt" | wc -l) cells)" \
+  test -z "$(comm -12 <(sauce_ids "$tmp/dry1.txt") <(sauce_ids "$tmp/dry2.txt"))" -a "$(sauce_ids "$tmp/dry2.txt" | wc -l)" -eq 3
+check "and no bar3 id" test "$(bar3_ids "$tmp/dry1.txt")" = "$(bar3_ids "$tmp/dry2.txt")"
+
+sed 's/"1,4,6"/"4,1"/' "$tmp/m.json" >"$tmp/bad.json"
+expect_input_error "^mpmbench: error: .*bad.json: scenes.sauce.reference.sample_frames: --sample-frames '4,1': frame 1 after 4" matrix run "$tmp/bad.json" --out "$tmp/b" --dry-run
+sed 's/"scale": 5}/"scale": 5, "first_timed_frame": 1}/' "$tmp/m.json" >"$tmp/first.json"
+expect_input_error "^mpmbench: error: .*first.json: scenes.sauce.reference.sample_frames: not with first_timed_frame 1" matrix run "$tmp/first.json" --out "$tmp/f" --dry-run
+finish
