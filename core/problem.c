@@ -58,10 +58,51 @@ static int ensure_capacity(StepProblem *pb, size_t np, int nn)
         st |= grow((void **)&pb->slot, sizeof(short) * NEIGH * c);
         st |= grow((void **)&pb->rowmask, sizeof(uint64_t) * 2 * c);
         st |= grow((void **)&pb->tmp, sizeof(double) * 3 * c);
+        st |= grow((void **)&pb->halo, sizeof(double) * 3 * c);
         if (st) return MPM_EINTERNAL;
         pb->cap_nodes = (int)c;
     }
     return MPM_OK;
+}
+
+/* ---- a distributed run (pb->comm; docs/distributed.md) ---- */
+
+/* The ghosts' partial sums of a node field (width values a node) added
+ * into their owners. */
+static void halo_sum(StepProblem *pb, double *v, int width)
+{
+    if (pb->comm && pb->comm->halo_sum(pb->comm->ctx, v, width)) pb->comm_failed = 1;
+}
+
+/* Zero at every ghost: an outgoing field is its owners'. */
+static void zero_ghosts(const StepProblem *pb, double *v, int width)
+{
+    if (!pb->comm) return;
+    for (int i = 0; i < pb->n_nodes; ++i)
+        if (!pb->owned[i]) memset(v + (size_t)width * i, 0, sizeof(double) * (size_t)width);
+}
+
+/* An incoming node field with its ghosts set from their owners (v itself
+ * on one process). */
+static const double *with_ghosts(StepProblem *pb, const double *v)
+{
+    if (!pb->comm) return v;
+    memcpy(pb->halo, v, sizeof(double) * 3 * (size_t)pb->n_nodes);
+    if (pb->comm->halo_copy(pb->comm->ctx, pb->halo, 3)) pb->comm_failed = 1;
+    return pb->halo;
+}
+
+/* A sum over the ranks (the value itself on one process). */
+static double ranks_sum(StepProblem *pb, double v)
+{
+    if (pb->comm && pb->comm->sum(pb->comm->ctx, &v, 1)) pb->comm_failed = 1;
+    return v;
+}
+
+static double ranks_max(StepProblem *pb, double v)
+{
+    if (pb->comm && pb->comm->max(pb->comm->ctx, &v, 1)) pb->comm_failed = 1;
+    return v;
 }
 
 int problem_prepare(StepProblem *pb, const Grid *g, const Stencils *st, const Particles *p,
@@ -103,8 +144,14 @@ int problem_prepare(StepProblem *pb, const Grid *g, const Stencils *st, const Pa
             for (int b = 0; b < 3; ++b) a[3 * s + b] = Fn[b] * gw[0] + Fn[3 + b] * gw[1] + Fn[6 + b] * gw[2];
         }
     }
-    pb->max_stiffness = maxstiff;
-    if (g->n == 0) return MPM_OK; /* no particles yet (a scene of sources only): nothing to set up */
+    pb->max_stiffness = ranks_max(pb, maxstiff);
+    pb->n_global = g->n;
+    if (pb->comm) {
+        int owned = 0;
+        for (int i = 0; i < g->n; ++i) owned += pb->owned[i];
+        pb->n_global = ranks_sum(pb, owned);
+    }
+    if (g->n == 0 && !pb->comm) return MPM_OK; /* no particles yet (a scene of sources only): nothing to set up */
 
     /* CN scale: kappa_i = 24 dx^2 dt abar_i, abar_i = sum_p w_ip m_p a_p / m_i
      * (SPEC 4, HOT §5.2). Scatter by particle-block colour. */
@@ -118,12 +165,15 @@ int problem_prepare(StepProblem *pb, const Grid *g, const Stencils *st, const Pa
         for (int t = 0; t < 27; ++t)
             if (node[t] >= 0) num[node[t]] += w[t] * s;
     }
+    halo_sum(pb, num, 1); /* distributed: the owners' sums (a ghost's is its owner's, copied below) */
     double min_pos = INFINITY;
     for (int i = 0; i < g->n; ++i) {
+        if (pb->comm && !pb->owned[i]) continue;
         double abar = num[i] / g->mass[i];
         num[i] = abar;
         if (abar > 0.0 && abar < min_pos) min_pos = abar;
     }
+    min_pos = -ranks_max(pb, -min_pos);
     if (!isfinite(min_pos)) min_pos = 1.0; /* no elastic particle at all: plain residual */
     double scale = 24.0 * pb->dx * pb->dx * dt;
 #pragma omp parallel for schedule(static)
@@ -131,6 +181,7 @@ int problem_prepare(StepProblem *pb, const Grid *g, const Stencils *st, const Pa
         double abar = num[i] > 0.0 ? num[i] : min_pos; /* SPEC 4 guard */
         pb->kappa[i] = scale * abar;
     }
+    if (pb->comm && pb->comm->halo_copy(pb->comm->ctx, pb->kappa, 1)) pb->comm_failed = 1;
     memset(pb->bc, BC_FREE, (size_t)g->n);
     /* initial guess of free nodes: dt g (HOT reference §1.3) */
 #pragma omp parallel for schedule(static)
@@ -272,16 +323,22 @@ static double inertial_range(const void *ctx, size_t begin, size_t end)
 
 double problem_energy(StepProblem *pb, const double *dv)
 {
-    EnergyArgs ea = {pb, dv};
+    EnergyArgs ea = {pb, with_ghosts(pb, dv)};
     pb->tangent_stored = 0; /* F changes */
     double elastic = reduce_sum(pb->parts->n, 64, elastic_range, &ea);
-    pb->elastic_energy = elastic;
     double inertial = reduce_sum((size_t)pb->n_nodes, 1024, inertial_range, &ea);
+    if (pb->comm) { /* both sums over the ranks, in one reduction */
+        double both[2] = {elastic, inertial};
+        if (pb->comm->sum(pb->comm->ctx, both, 2)) pb->comm_failed = 1;
+        elastic = both[0], inertial = both[1];
+    }
+    pb->elastic_energy = elastic;
     return inertial + elastic;
 }
 
-void problem_gradient(StepProblem *pb, const double *dv, double *grad)
+void problem_gradient(StepProblem *pb, const double *dv_in, double *grad)
 {
+    const double *dv = with_ghosts(pb, dv_in);
     const Particles *p = pb->parts;
     const Stencils *st = pb->st;
     const double *m = pb->grid->mass;
@@ -312,6 +369,8 @@ void problem_gradient(StepProblem *pb, const double *dv, double *grad)
             }
         }
     }
+    halo_sum(pb, grad, 3);
+    zero_ghosts(pb, grad, 3);
     problem_project(pb, grad);
 }
 
@@ -681,6 +740,8 @@ static int assemble(StepProblem *pb, Bsr *H, int fused, int projected)
 
 int problem_assemble(StepProblem *pb, Bsr *H)
 {
+    if (pb->comm)
+        return mpm_error(MPM_EINPUT, "an assembled Hessian is not distributed over ranks yet: use a matrix-free solver");
     if (!pb->tangent_stored)
         return mpm_error(MPM_EINTERNAL, "problem_assemble: no tangent stored (problem_tangent first)");
     return assemble(pb, H, 0, pb->tangent_projected);
@@ -688,13 +749,16 @@ int problem_assemble(StepProblem *pb, Bsr *H)
 
 int problem_assemble_fused(StepProblem *pb, int projected, Bsr *H)
 {
+    if (pb->comm)
+        return mpm_error(MPM_EINPUT, "an assembled Hessian is not distributed over ranks yet: use a matrix-free solver");
     pb->tangent_stored = 0; /* pb->A is not updated */
     pb->tangent_projected = projected;
     return assemble(pb, H, 1, projected);
 }
 
-void problem_hessvec(StepProblem *pb, const double *x, double *y)
+void problem_hessvec(StepProblem *pb, const double *x_in, double *y)
 {
+    const double *x = with_ghosts(pb, x_in);
     const Stencils *st = pb->st;
     const Particles *p = pb->parts;
     const double *m = pb->grid->mass;
@@ -743,6 +807,7 @@ void problem_hessvec(StepProblem *pb, const double *x, double *y)
             y[3 * i + 2] += s * f[2];
         }
     }
+    halo_sum(pb, y, 3); /* before the constraints: they act once, at the owner */
     if (pb->n_dirichlet) {
 #pragma omp parallel for schedule(static)
         for (int i = 0; i < n; ++i) {
@@ -761,6 +826,7 @@ void problem_hessvec(StepProblem *pb, const double *x, double *y)
             }
         }
     }
+    zero_ghosts(pb, y, 3);
 }
 
 void problem_diagonal(StepProblem *pb, double *D)
@@ -794,6 +860,7 @@ void problem_diagonal(StepProblem *pb, double *D)
             for (int e = 0; e < 9; ++e) Di[e] += K[e];
         }
     }
+    halo_sum(pb, D, 9); /* before the constraints: they act once, at the owner */
     if (pb->n_dirichlet) {
 #pragma omp parallel for schedule(static)
         for (int i = 0; i < n; ++i) {
@@ -803,6 +870,13 @@ void problem_diagonal(StepProblem *pb, double *D)
             add_complement(pb, i, Di);
         }
     }
+    if (pb->comm) /* a ghost's block is the identity: an inverse of it stays finite and leaves zeros zero */
+        for (int i = 0; i < n; ++i)
+            if (!pb->owned[i]) {
+                double *Di = D + 9 * (size_t)i;
+                memset(Di, 0, 9 * sizeof(double));
+                Di[0] = Di[4] = Di[8] = 1.0;
+            }
 }
 
 void problem_mark_dirichlet(StepProblem *pb, DirichletFn fn, const void *ctx)
@@ -848,14 +922,19 @@ static double cn_range(const void *ctx, size_t begin, size_t end)
 
 double problem_cn_residual(const StepProblem *pb, const double *g)
 {
-    if (pb->n_nodes <= 0) return 0.0;
+    if (pb->n_nodes <= 0 && !pb->comm) return 0.0; /* a rank without nodes still takes part in the sum */
     CnArgs ca = {g, pb->kappa};
-    return sqrt(reduce_sum((size_t)pb->n_nodes, 1024, cn_range, &ca) / pb->n_nodes);
+    double sum = reduce_sum((size_t)pb->n_nodes, 1024, cn_range, &ca);
+    if (!pb->comm) return sqrt(sum / pb->n_nodes);
+    /* ghosts hold zeros: the local sum is the owned nodes' share */
+    StepProblem *mut = (StepProblem *)pb; /* the failure flag only */
+    return sqrt(ranks_sum(mut, sum) / pb->n_global);
 }
 
 double problem_tau(const StepProblem *pb, double eps)
 {
-    return eps * pb->dt * 24.0 * sqrt((double)pb->n_nodes) * pb->dx * pb->dx * pb->max_stiffness;
+    double n = pb->comm ? pb->n_global : (double)pb->n_nodes;
+    return eps * pb->dt * 24.0 * sqrt(n) * pb->dx * pb->dx * pb->max_stiffness;
 }
 
 void problem_free(StepProblem *pb)
@@ -874,5 +953,6 @@ void problem_free(StepProblem *pb)
     free(pb->slot);
     free(pb->rowmask);
     free(pb->tmp);
+    free(pb->halo);
     memset(pb, 0, sizeof *pb);
 }

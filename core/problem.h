@@ -24,6 +24,7 @@
 #include <stddef.h>
 
 #include "core/bsr.h"
+#include "core/dist/comm_ops.h"
 #include "core/grid.h"
 #include "core/material.h"
 #include "core/particles.h"
@@ -77,6 +78,21 @@ typedef struct StepProblem {
     int pattern_ready;
     short *slot;         /* 125 per node: position of neighbour offset in the row, -1 absent */
     uint64_t *rowmask;   /* 2 per node: neighbour offsets present */
+
+    /* A distributed run (docs/distributed.md; comm NULL: one process).
+     * The local grid holds owned nodes and ghosts; ghosts carry no mass
+     * (their inertia is their owner's). Node fields that come in (dv, x)
+     * are read with their ghosts set from the owners; the ones that go out
+     * (a gradient, H x, the diagonal) hold the sums of every rank's
+     * particles at the owners and zero (identity blocks for the diagonal)
+     * at the ghosts, so sums over the local nodes are the owned nodes'
+     * share of the global ones; energies, norms and counts are summed over
+     * the ranks. A failed communication sets comm_failed. */
+    const CommOps *comm;
+    const unsigned char *owned; /* per node: 1 when this rank owns it (comm only) */
+    double n_global;     /* the active nodes of every rank (the CN rule's count) */
+    int comm_failed;
+    double *halo;        /* 3 per node: an incoming field with its ghosts */
 
     /* scratch */
     double *tmp;         /* 3 per node */

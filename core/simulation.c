@@ -43,6 +43,8 @@ void sim_free(Simulation *sim)
     problem_free(&sim->pb);
     free(sim->vnew);
     free(sim->grad);
+    decomposition_free(&sim->decomp);
+    dist_grid_free(&sim->dist);
     memset(sim, 0, sizeof *sim);
 }
 
@@ -61,6 +63,13 @@ int sim_next_dt(const Simulation *sim, double *dt_out)
             if (x[d] < lo[d]) lo[d] = x[d];
             if (x[d] > hi[d]) hi[d] = x[d];
         }
+    }
+    if (sim->comm) { /* over every rank's particles: every rank takes the same step */
+        double r[7] = {vmax, -lo[0], -lo[1], -lo[2], hi[0], hi[1], hi[2]};
+        int st = sim->comm->max(sim->comm->ctx, r, 7);
+        if (st) return st;
+        vmax = r[0];
+        for (int d = 0; d < 3; ++d) lo[d] = -r[1 + d], hi[d] = r[4 + d];
     }
     vmax = sqrt(vmax);
     const char *who = "particle";

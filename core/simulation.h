@@ -3,6 +3,9 @@
 #ifndef MPM_SIMULATION_H
 #define MPM_SIMULATION_H
 
+#include "core/dist/comm_ops.h"
+#include "core/dist/decomposition.h"
+#include "core/dist/dist_grid.h"
 #include "core/grid.h"
 #include "core/position_update.h"
 #include "core/problem.h"
@@ -29,6 +32,10 @@ typedef struct {
     int cap_grad;
     int volumes_done;     /* "particle_volume": "grid_density" applied (first step) */
     PositionUpdateStats pos_stats; /* last step's backward-Euler position update */
+    /* one scene over MPI ranks (core/dist/dist_sim.h; comm NULL: one process) */
+    const CommOps *comm;
+    Decomposition decomp; /* the blocks each rank owns */
+    DistGrid dist;        /* this rank's owned nodes and ghosts */
 } Simulation;
 
 int sim_init(Simulation *sim, const Scene *scene);

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "core/collider.h"
+#include "core/dist/dist_sim.h"
 #include "core/error.h"
 #include "core/plasticity.h"
 #include "core/transfer.h"
@@ -126,14 +127,26 @@ static void collider_dirichlet(const void *ctx, StepProblem *pb, int i, const do
 static int check_node_masses(const Simulation *sim)
 {
     const Grid *g = &sim->grid;
+    const unsigned char *owned = sim->comm ? sim->dist.owned : NULL; /* a ghost's mass is its owner's */
     int bad = g->n;
 #pragma omp parallel for schedule(static) reduction(min : bad)
     for (int i = 0; i < g->n; ++i)
-        if (!(g->mass[i] > 0.0 && g->mass[i] <= 1e300) && i < bad) bad = i;
+        if ((!owned || owned[i]) && !(g->mass[i] > 0.0 && g->mass[i] <= 1e300) && i < bad) bad = i;
     if (bad == g->n) return MPM_OK;
     const double dx = g->dx;
     return mpm_error(MPM_ENUMERIC, "t = %.9g s: grid node %d at (%g, %g, %g) got mass %g from P2G", sim->t, bad,
                      g->coord[3 * bad] * dx, g->coord[3 * bad + 1] * dx, g->coord[3 * bad + 2] * dx, g->mass[bad]);
+}
+
+/* Over MPI ranks: every rank's worst status, so all stop together when one
+ * fails (its own message, or "another rank failed"); st itself on one
+ * process. */
+static int ranks_agree(const Simulation *sim, int st)
+{
+    if (!sim->comm) return st;
+    int all = MPM_OK, cst = sim->comm->agree(sim->comm->ctx, st, &all);
+    if (cst || st) return cst ? cst : st;
+    return all ? mpm_error(all, "another rank failed (rank %d stops with it)", sim->comm->rank) : MPM_OK;
 }
 
 int step_begin(Simulation *sim)
@@ -143,18 +156,27 @@ int step_begin(Simulation *sim)
     if (sim->dt_next > 0.0) sim->dt = sim->dt_next; /* a replayed step (--dt-from) */
     else if ((st = sim_next_dt(sim, &sim->dt))) return st;
     sim->dt_next = 0.0;
-    if ((st = grid_build(&sim->grid, &sim->st, &sim->p, sc->dx))) return st;
+    if (sim->comm) /* a rank's grid: its particles' nodes, the owned nodes only others reach, the halo */
+        st = dist_grid_build(&sim->dist, &sim->decomp, sim->comm, &sim->grid, &sim->st, &sim->p, sc->dx);
+    else
+        st = grid_build(&sim->grid, &sim->st, &sim->p, sc->dx);
+    if (st) return st;
     if (sc->transfer == TRANSFER_MLS) { /* SPEC 9: MLS gradients everywhere, fused P2G */
         stencils_use_mls_gradients(&sim->st, &sim->p, sc->dx);
         transfer_p2g_mls(&sim->grid, &sim->st, &sim->p, NULL);
     } else {
         transfer_p2g(&sim->grid, &sim->st, &sim->p);
     }
-    if ((st = check_node_masses(sim))) return st;
+    if (sim->comm && (st = dist_p2g_halo(sim))) return st;
+    st = ranks_agree(sim, check_node_masses(sim));
+    if (st) return st;
     estimate_volumes(sim);
-    if ((st = problem_prepare(&sim->pb, &sim->grid, &sim->st, &sim->p, sc->materials, sc->n_materials, sim->dt,
-                              sc->gravity)))
-        return st;
+    sim->pb.comm = sim->comm;
+    sim->pb.owned = sim->comm ? sim->dist.owned : NULL;
+    sim->pb.comm_failed = 0;
+    st = problem_prepare(&sim->pb, &sim->grid, &sim->st, &sim->p, sc->materials, sc->n_materials, sim->dt, sc->gravity);
+    if (!st && sim->pb.comm_failed) st = mpm_error(MPM_EINTERNAL, "t = %.9g s: a halo exchange failed", sim->t);
+    if ((st = ranks_agree(sim, st))) return st;
     problem_mark_dirichlet(&sim->pb, sc->n_colliders ? collider_dirichlet : NULL, sim);
     return MPM_OK;
 }

@@ -1,0 +1,28 @@
+/* A simulation split over MPI ranks (docs/distributed.md): each rank keeps
+ * the particles of the blocks it owns and runs the step on its own grid
+ * (owned nodes and ghosts), communicating through the table of
+ * core/dist/comm_ops.h. With a distributed simulation, step_begin builds
+ * the rank's grid with its halo (dist_grid.h), sums P2G's mass and
+ * momentum into the owners, gives the ghosts their owners' velocities and
+ * no mass, and hands the step problem the table and the owned nodes
+ * (core/problem.h), so its energy, gradient, H x, diagonal and CN residual
+ * are the whole scene's. */
+#ifndef MPM_DIST_SIM_H
+#define MPM_DIST_SIM_H
+
+#include "core/dist/comm_ops.h"
+#include "core/simulation.h"
+
+/* Splits sim (initialised by sim_init on every rank from the same scene)
+ * over comm's ranks: the decomposition of its particles, then only this
+ * rank's particles kept. Collective. MPM_EINPUT for what has no
+ * distributed form yet (MLS transfers, grid-density volumes, sources) and
+ * for more ranks than blocks. */
+int sim_distribute(Simulation *sim, const CommOps *comm);
+
+/* After P2G on a rank's grid: mass and momentum summed into the owners,
+ * the owners' velocities, copied to the ghosts, and the ghosts' mass set
+ * to 0 (their inertia is the owner's). Collective. */
+int dist_p2g_halo(Simulation *sim);
+
+#endif

@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# needs: MPM_WITH_PETSC
+# The tests of tests/dist/ across MPI ranks, on 2 and 3 ranks
+# (oversubscribed on a 2-core machine is fine): test_dist_halo (the halo
+# sum and copy of a split grid through PetscSF equal the whole grid's P2G;
+# a failure on one rank ends the grid's set-up on every rank with an error
+# instead of a hang) and test_dist_problem (a split scene's step problem:
+# energy, gradient, H x, diagonal, CN residual equal the whole scene's).
+# mpirun_ranks' timeout turns a hang into a failure.
+. "$(dirname "$0")/../common/shell_harness.sh"
+command -v mpirun >/dev/null || skip "mpirun not found"
+for name in test_dist_halo test_dist_problem; do
+  helper="$(dirname "$bin")/tests/$name"
+  [ -x "$helper" ] || { echo "FAIL: $helper not built"; fails=$((fails + 1)); continue; }
+  for ranks in 2 3; do
+    out="$tmp/$name.$ranks"
+    mpirun_ranks -np $ranks "$helper" >"$out" 2>&1
+    rc=$?
+    check "$name on $ranks ranks: exit 0 ($(grep -c 'check failed' "$out") failed checks; exit $rc)" test $rc -eq 0
+    check "$name on $ranks ranks: every rank reports" test "$(grep -c ' 0 failed$' "$out")" -eq $ranks
+    [ $rc -eq 0 ] || head -20 "$out"
+  done
+done
+finish
