@@ -245,15 +245,6 @@ int run_config_check(const RunConfig *cfg)
         if (other)
             return mpm_error(MPM_EINPUT, "--sample-frames: not with %s (each sampled frame runs alone from its checkpoint)",
                              other);
-        int frames[RUN_MAX_LIST], n = sample_list(cfg->sample_frames, frames);
-        for (int i = 0; i < n; ++i) {
-            char path[1200];
-            int frame;
-            sample_path(cfg->sample_from, frames[i], path, sizeof path);
-            if ((st = checkpoint_frame(path, &frame))) return mpm_error_context(st, "--sample-frames %d", frames[i]);
-            if (frame != frames[i])
-                return mpm_error(MPM_EINPUT, "--sample-frames %d: %s starts at frame %d", frames[i], path, frame);
-        }
     }
     if (cfg->from) {
         /* the replays and comparisons count frames from the start of the animation */
@@ -476,10 +467,13 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
         session_close(&ses);
         return status;
     }
-    for (int i = 0; i < n_samples && !status; ++i) { /* every sampled state is of this scene */
+    for (int i = 0; i < n_samples && !status; ++i) { /* every sampled state is there and of this scene */
         char path[1200];
         sample_path(cfg->sample_from, samples[i], path, sizeof path);
-        status = checkpoint_read(path, sim, fingerprint);
+        if ((status = checkpoint_read(path, sim, fingerprint)))
+            status = mpm_error_context(status, "--sample-frames %d", samples[i]);
+        else if (sim->frame != samples[i])
+            status = mpm_error(MPM_EINPUT, "--sample-frames %d: %s starts at frame %d", samples[i], path, sim->frame);
     }
     if (status) {
         run_accuracy_free(&acc);
