@@ -254,6 +254,8 @@ int step_end(Simulation *sim, const double *dv)
     for (size_t k = 0; k < 3 * (size_t)g->n; ++k) sim->vnew[k] = g->v[k] + dv[k];
     int fst = apply_collider_friction(sim, dv);
     if (fst) return fst;
+    /* over ranks: the solver's dv is zero at the ghosts; G2P reads their owners' v^{n+1} */
+    if (sim->comm && (fst = sim->comm->halo_copy(sim->comm->ctx, sim->vnew, 3))) return fst;
     grid_to_particles(sim);
     if (sc->needs_plasticity) {
         int st = plasticity_apply(&sim->p, sc->materials, sc->n_materials);
@@ -270,5 +272,11 @@ int step_end(Simulation *sim, const double *dv)
         sim->frame++;
     }
     if (sc->domain_walls) hold_at_walls(sim);
-    return check_state(sim);
+    int st = ranks_agree(sim, check_state(sim));
+    if (!st && sim->comm) { /* particles into the ranks owning their new base blocks */
+        size_t sent = 0;
+        st = dist_migrate(sim, &sent);
+        sim->dist.migrated += sent;
+    }
+    return st;
 }

@@ -21,6 +21,7 @@ typedef struct {
     HaloPlan plan;         /* the ghosts: local id, owner rank, the owner's local id */
     int *ghost_node, *owner_rank, *owner_node; /* the plan's storage */
     int n_extra;           /* owned nodes only other ranks' particles reach */
+    size_t migrated;       /* particles this rank has sent to others since the start (dist_migrate) */
     int cap_nodes, cap_ghosts;
 } DistGrid;
 

@@ -2,6 +2,7 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "core/error.h"
@@ -10,10 +11,12 @@
 int sim_distribute(Simulation *sim, const CommOps *comm)
 {
     const Scene *sc = sim->scene;
-    const char *missing = sc->transfer == TRANSFER_MLS ? "MLS transfers"
-                          : sc->volumes_from_density  ? "grid-density particle volumes"
-                          : sc->n_sources             ? "particle sources"
-                                                      : NULL;
+    const char *missing = sc->transfer == TRANSFER_MLS                        ? "MLS transfers"
+                          : sc->volumes_from_density                         ? "grid-density particle volumes"
+                          : sc->n_sources                                    ? "particle sources"
+                          : sim->has_friction                                ? "collider friction"
+                          : sc->position_update == POSITION_BACKWARD_EULER   ? "backward-Euler position updates"
+                                                                             : NULL;
     if (missing) return mpm_error(MPM_EINPUT, "%s: %s are not distributed over ranks yet", sc->name, missing);
     Particles *p = &sim->p;
     size_t n = p->n;
@@ -72,5 +75,99 @@ int dist_p2g_halo(Simulation *sim)
     for (int i = 0; !st && i < g->n; ++i)
         if (!owned[i]) g->mass[i] = 0.0;
     free(mom);
+    return st;
+}
+
+/* A particle as 64-bit items for the exchange: x, v, C, F, mass, volume,
+ * material, identity, then Jp when the particles keep it. */
+enum { ITEMS_BASE = 3 + 3 + 9 + 9 + 1 + 1 + 1 + 1 };
+
+static void pack_particle(const Particles *p, size_t k, uint64_t *out)
+{
+    double d[26];
+    memcpy(d, p->x + 3 * k, 3 * sizeof(double));
+    memcpy(d + 3, p->v + 3 * k, 3 * sizeof(double));
+    memcpy(d + 6, p->C + 9 * k, 9 * sizeof(double));
+    memcpy(d + 15, p->F + 9 * k, 9 * sizeof(double));
+    d[24] = p->mass[k];
+    d[25] = p->vol[k];
+    memcpy(out, d, sizeof d);
+    out[26] = (uint64_t)(int64_t)p->mat[k];
+    out[27] = p->id ? (uint64_t)p->id[k] : 0;
+    if (p->Jp) memcpy(out + ITEMS_BASE, p->Jp + k, sizeof(double));
+}
+
+static void unpack_particle(const uint64_t *in, Particles *p, size_t k)
+{
+    double d[26];
+    memcpy(d, in, sizeof d);
+    memcpy(p->x + 3 * k, d, 3 * sizeof(double));
+    memcpy(p->v + 3 * k, d + 3, 3 * sizeof(double));
+    memcpy(p->C + 9 * k, d + 6, 9 * sizeof(double));
+    memcpy(p->F + 9 * k, d + 15, 9 * sizeof(double));
+    p->mass[k] = d[24];
+    p->vol[k] = d[25];
+    p->mat[k] = (int)(int64_t)in[26];
+    if (p->id) p->id[k] = (size_t)in[27];
+    if (p->Jp) memcpy(p->Jp + k, in + ITEMS_BASE, sizeof(double));
+}
+
+/* Copies particle `from` to index `to` (to <= from). */
+static void move_particle(Particles *p, size_t from, size_t to)
+{
+    uint64_t buf[ITEMS_BASE + 1];
+    pack_particle(p, from, buf);
+    unpack_particle(buf, p, to);
+}
+
+int dist_migrate(Simulation *sim, size_t *sent)
+{
+    const CommOps *c = sim->comm;
+    const int R = c->ranks, me = c->rank;
+    Particles *p = &sim->p;
+    const double dx = sim->scene->dx;
+    const size_t n = p->n, W = ITEMS_BASE + (p->Jp ? 1 : 0);
+    int *dest = malloc(sizeof(int) * (n ? n : 1));
+    int *send_counts = calloc((size_t)R, sizeof(int)), *recv_counts = calloc((size_t)R, sizeof(int));
+    size_t *at = calloc((size_t)R + 1, sizeof(size_t));
+    uint64_t *send = NULL, *recv = NULL;
+    size_t leaving = 0;
+    int st = dest && send_counts && recv_counts && at ? MPM_OK : mpm_error(MPM_EINTERNAL, "out of memory: migration");
+    for (size_t k = 0; !st && k < n; ++k) { /* the owner of the particle's base node's block, after the move */
+        int base[3];
+        for (int d = 0; d < 3; ++d) base[d] = (int)floor(p->x[3 * k + d] / dx - 0.5);
+        dest[k] = decomposition_node_owner(&sim->decomp, base);
+        if (dest[k] != me) send_counts[dest[k]] += (int)W, ++leaving;
+    }
+    if (!st) {
+        for (int r = 0; r < R; ++r) at[r + 1] = at[r] + (size_t)send_counts[r];
+        send = malloc(sizeof(uint64_t) * (at[R] ? at[R] : 1));
+        if (!send) st = mpm_error(MPM_EINTERNAL, "out of memory: %zu particles leaving", leaving);
+    }
+    for (size_t k = 0; !st && k < n; ++k)
+        if (dest[k] != me) {
+            pack_particle(p, k, send + at[dest[k]]);
+            at[dest[k]] += W;
+        }
+    int all = MPM_OK, cst = c->agree(c->ctx, st, &all);
+    if (!cst && !st && all) st = mpm_error(all, "another rank failed (rank %d stops with it)", me);
+    if (!cst && !st) cst = c->exchange(c->ctx, send_counts, send, recv_counts, &recv);
+    if (!st) st = cst;
+    if (!st) { /* the staying particles in their order, then the arrivals rank after rank */
+        size_t kept = 0, arriving = 0;
+        for (size_t k = 0; k < n; ++k)
+            if (dest[k] == me) move_particle(p, k, kept++);
+        for (int r = 0; r < R; ++r) arriving += (size_t)recv_counts[r] / W;
+        st = particles_reserve(p, kept + arriving);
+        for (size_t j = 0; !st && j < arriving; ++j) unpack_particle(recv + j * W, p, kept + j);
+        if (!st) p->n = kept + arriving;
+    }
+    if (sent) *sent = leaving;
+    free(dest);
+    free(send_counts);
+    free(recv_counts);
+    free(at);
+    free(send);
+    free(recv);
     return st;
 }

@@ -16,13 +16,20 @@
 /* Splits sim (initialised by sim_init on every rank from the same scene)
  * over comm's ranks: the decomposition of its particles, then only this
  * rank's particles kept. Collective. MPM_EINPUT for what has no
- * distributed form yet (MLS transfers, grid-density volumes, sources) and
- * for more ranks than blocks. */
+ * distributed form yet (MLS transfers, grid-density volumes, sources,
+ * collider friction, backward-Euler position updates) and for more ranks
+ * than blocks. */
 int sim_distribute(Simulation *sim, const CommOps *comm);
 
 /* After P2G on a rank's grid: mass and momentum summed into the owners,
  * the owners' velocities, copied to the ghosts, and the ghosts' mass set
  * to 0 (their inertia is the owner's). Collective. */
 int dist_p2g_halo(Simulation *sim);
+
+/* After G2P: every particle whose base node's block belongs to another
+ * rank moves there (exchange); the staying ones keep their order, the
+ * arrivals follow rank after rank. *sent (when not NULL) gets how many
+ * left this rank. Collective. */
+int dist_migrate(Simulation *sim, size_t *sent);
 
 #endif

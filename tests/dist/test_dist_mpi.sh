@@ -5,13 +5,15 @@
 # sum and copy of a split grid through PetscSF equal the whole grid's P2G;
 # a failure on one rank ends the grid's set-up on every rank with an error
 # instead of a hang), test_dist_problem (a split scene's step problem:
-# energy, gradient, H x, diagonal, CN residual equal the whole scene's) and
+# energy, gradient, H x, diagonal, CN residual equal the whole scene's),
 # test_dist_solve (pn-pcg-mf and lbfgs:jacobi across ranks: the whole
-# scene's iterations and solution).
+# scene's iterations and solution) and test_dist_steps (12 whole time steps
+# of drop with migration: the whole scene's iterations, time steps, particle
+# positions, mass and momentum).
 # mpirun_ranks' timeout turns a hang into a failure.
 . "$(dirname "$0")/../common/shell_harness.sh"
 command -v mpirun >/dev/null || skip "mpirun not found"
-for name in test_dist_halo test_dist_problem test_dist_solve; do
+for name in test_dist_halo test_dist_problem test_dist_solve test_dist_steps; do
   helper="$(dirname "$bin")/tests/$name"
   [ -x "$helper" ] || { echo "FAIL: $helper not built"; fails=$((fails + 1)); continue; }
   for ranks in 2 3; do
