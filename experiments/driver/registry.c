@@ -347,3 +347,18 @@ int registry_print_spec_definitions(FILE *f, const char *const *specs, int n)
     for (int i = 0; i < n && !st; ++i) st = print_definition(f, specs[i], specs[i]);
     return st;
 }
+
+#if MPM_WITH_PETSC
+extern int petsc_comm_open(CommOps *ops); /* adapters/petsc_comm.h */
+#endif
+
+int registry_comm_open(CommOps *ops)
+{
+#if MPM_WITH_PETSC
+    return petsc_comm_open(ops);
+#else
+    (void)ops;
+    return mpm_error(MPM_EINPUT, "this build cannot split a scene over MPI ranks: it needs the PETSc adapter "
+                                 "(cmake -DMPM_WITH_PETSC=ON, Debian package libpetsc-real3.18-dev)");
+#endif
+}

@@ -79,4 +79,10 @@ int registry_print_definitions(FILE *f);
 /* The same for the given specs, each line named by its spec. */
 int registry_print_spec_definitions(FILE *f, const char *const *specs, int n);
 
+/* The communication of a scene split over MPI ranks (core/dist/comm_ops.h)
+ * from the adapter that provides it (PETSc's: adapters/petsc_comm.h);
+ * MPM_EINPUT naming the option that builds it when this build has none. */
+#include "core/dist/comm_ops.h"
+int registry_comm_open(CommOps *ops);
+
 #endif

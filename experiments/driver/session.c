@@ -5,7 +5,9 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "core/dist/dist_sim.h"
 #include "core/error.h"
+#include "core/vec.h"
 #include "experiments/driver/library_startup.h"
 #include "experiments/driver/registry.h"
 
@@ -51,6 +53,12 @@ int session_open(const SessionConfig *c, Session *s)
     s->has_scene = 1;
     s->has_sim = 1; /* sim_free undoes a partial sim_init */
     if ((st = sim_init(&s->sim, &s->scene))) goto fail;
+    if (c->distributed) {
+        if ((st = registry_comm_open(&s->comm))) goto fail;
+        s->has_comm = 1;
+        if ((st = sim_distribute(&s->sim, &s->comm))) goto fail;
+        vec_sum_over_ranks(&s->comm);
+    }
     return MPM_OK;
 fail:
     session_close(s);
@@ -59,6 +67,10 @@ fail:
 
 void session_close(Session *s)
 {
+    if (s->has_comm) {
+        vec_sum_over_ranks(NULL);
+        s->comm.close(s->comm.ctx);
+    }
     if (s->has_sim) sim_free(&s->sim);
     if (s->has_scene) scene_free(&s->scene);
     solver_destroy(s->solver);

@@ -32,6 +32,7 @@ typedef struct {
     const char *const *solver_opts; /* KEY=VALUE options applied after the spec's */
     int n_solver_opts;
     int threads;                    /* <= 0: OpenMP's default (OMP_NUM_THREADS or every core) */
+    int distributed;                /* split the scene over the MPI ranks the program runs on (core/dist/) */
 } SessionConfig;
 
 /* Not to be copied: sim points into scene. */
@@ -41,6 +42,8 @@ typedef struct {
     Simulation sim;
     int threads;     /* the size of the OpenMP team the session runs on */
     int has_scene, has_sim;
+    CommOps comm;    /* distributed: the ranks' communication (sim.comm points here) */
+    int has_comm;
 } Session;
 
 /* Checks an override text: PATH=VALUE, shorter than SESSION_SET_TEXT.
@@ -54,7 +57,10 @@ int session_load_scene(const SessionConfig *c, Scene *scene);
 /* Makes the solver (checking the spec and every option before any work),
  * sizes the OpenMP team, starts the libraries the solver needs (MPI,
  * hypre, CHOLMOD; library_startup.h: timed apart from the steps), loads the
- * scene and initialises the simulation. On an error nothing is left to free. */
+ * scene and initialises the simulation; distributed, splits it over the
+ * ranks (sim_distribute) and makes the solvers' reductions sum over them
+ * (vec_sum_over_ranks) until session_close. On an error nothing is left to
+ * free. */
 int session_open(const SessionConfig *c, Session *s);
 
 void session_close(Session *s);

@@ -16,17 +16,10 @@
 #include "experiments/matrix/matrix_dispatch.h"
 #include "experiments/matrix/matrix_file.h"
 #include "experiments/matrix/matrix_results.h"
+#include "experiments/io/mpi_launcher.h"
 #include "experiments/io/paths.h"
 #include "experiments/matrix/matrix_validate.h"
 #include "experiments/run/provenance.h"
-
-int matrix_under_mpi_launcher(void)
-{
-    static const char *const vars[] = {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_SIZE", "PMI_RANK"};
-    for (int i = 0; i < 4; ++i)
-        if (getenv(vars[i])) return 1;
-    return 0;
-}
 
 typedef struct {
     Matrix m;
@@ -406,7 +399,7 @@ static void run_free(Run *r)
 int matrix_run(const char *file, const MatrixRunOptions *o, int *failed)
 {
     *failed = 0;
-    int use_mpi = matrix_under_mpi_launcher(), rank = 0, ranks = 1;
+    int use_mpi = under_mpi_launcher(), rank = 0, ranks = 1;
     if (use_mpi) {
         if (MPI_Init(NULL, NULL) != MPI_SUCCESS) return mpm_error(MPM_EINTERNAL, "MPI_Init failed");
         MPI_Comm_rank(MPI_COMM_WORLD, &rank);

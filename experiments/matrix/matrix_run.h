@@ -35,7 +35,4 @@ typedef struct {
 
 int matrix_run(const char *file, const MatrixRunOptions *o, int *failed);
 
-/* Was this process started by an MPI launcher (mpirun, srun with PMI/PMIx)? */
-int matrix_under_mpi_launcher(void);
-
 #endif

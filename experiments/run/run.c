@@ -15,6 +15,7 @@
 #include "core/step.h"
 #include "core/scene/scene_load.h"
 #include "experiments/io/checkpoint.h"
+#include "experiments/io/mpi_launcher.h"
 #include "experiments/io/csv_write.h"
 #include "experiments/io/machine_load.h"
 #include "experiments/driver/library_startup.h"
@@ -168,6 +169,9 @@ static void load_window_end(LoadWindow *w, int threads)
 }
 
 /* run.json gets "machine_load" once the frames have run. */
+/* The output folder of the ranks but 0 of a distributed run: they write nothing. */
+#define SECONDARY_RANK_DIR "/dev/null"
+
 /* Adds key = value (taken) to DIR/run.json, written before the frames ran. */
 static int add_to_run_json(const char *dir, const char *key, json_t *value)
 {
@@ -261,6 +265,11 @@ int run_config_check(const RunConfig *cfg)
 
 static FILE *open_in(const char *dir, const char *name, int *status)
 {
+    if (!strcmp(dir, SECONDARY_RANK_DIR)) { /* a distributed run's rank other than 0 writes nothing */
+        FILE *f = fopen("/dev/null", "w");
+        if (!f) *status = mpm_error(MPM_EINTERNAL, "/dev/null: cannot write");
+        return f;
+    }
     char path[1200];
     snprintf(path, sizeof path, "%s/%s", dir, name);
     FILE *f = fopen(path, "w");
@@ -280,6 +289,7 @@ typedef struct {
     VtkSeries *vtk;            /* --vtk: the ParaView series, else NULL */
     const char *out_dir;
     uint64_t fingerprint;      /* the scene's, for checkpoints */
+    const CommOps *comm;       /* a distributed run's ranks, else NULL */
 } RunOutput;
 
 /* --sample-frames: the state at the start of a sampled frame, from its checkpoint */
@@ -316,12 +326,15 @@ static int write_step(void *ctx, const Simulation *sim, int frame, int step, con
 {
     RunOutput *o = ctx;
     FILE *f = o->steps_csv;
+    /* over ranks: the whole scene's particles and (owned) nodes; every rank sums, rank 0 writes */
+    double counts[2] = {(double)sim->p.n, o->comm ? (double)sim->dist.n_owned : (double)si->active_nodes};
+    if (o->comm && o->comm->sum(o->comm->ctx, counts, 2)) return MPM_EINTERNAL;
     /* t and dt read back as the same doubles (--dt-from replays them) */
     csv_write_name(f, o->scene->name);
     fputc(',', f);
     csv_write_name(f, o->solver->name);
     fprintf(f, ",%d,%d,%.17g,%.17g,%zu,%d,%lld,%d,%ld,%d,%.6e,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%ld,",
-            frame, step, si->t, si->dt, sim->p.n, si->active_nodes,
+            frame, step, si->t, si->dt, (size_t)counts[0], (int)counts[1],
             (long long)ss->hessian_blocks, ss->outer_iters, ss->linear_iters, ss->ls_evals, ss->residual,
             solve_status_name(ss->status), si->wall_s, si->begin_s, ss->assemble_s, ss->setup_s, ss->solve_s,
             ss->linesearch_s, si->end_s, o->threads, ss->inner_iters);
@@ -426,6 +439,37 @@ static void write_run_json(const char *dir, const RunConfig *cfg, const Scene *s
     json_decref(root);
 }
 
+/* A distributed run's split into run.json ("distributed": the rank count,
+ * each rank's particles and owned nodes at the end, the particles each
+ * sent away over the run). Collective: every rank gathers, rank 0 writes. */
+static int add_distribution(const char *out_dir, const Session *ses)
+{
+    const CommOps *c = &ses->comm;
+    const int R = c->ranks;
+    double *v = calloc(3 * (size_t)R, sizeof(double));
+    if (!v) return mpm_error(MPM_EINTERNAL, "out of memory");
+    v[c->rank] = (double)ses->sim.p.n;
+    v[R + c->rank] = ses->sim.dist.n_owned;
+    v[2 * R + c->rank] = (double)ses->sim.dist.migrated;
+    int st = c->sum(c->ctx, v, 3 * R);
+    if (!st && c->rank == 0) {
+        json_t *d = json_object(), *parts = json_array(), *nodes = json_array(), *moved = json_array();
+        for (int r = 0; r < R; ++r) {
+            json_array_append_new(parts, json_integer((json_int_t)v[r]));
+            json_array_append_new(nodes, json_integer((json_int_t)v[R + r]));
+            json_array_append_new(moved, json_integer((json_int_t)v[2 * R + r]));
+        }
+        json_object_set_new(d, "ranks", json_integer(R));
+        json_object_set_new(d, "decomposition", json_string("4x4x4 node blocks along a Morton curve, cut by particles"));
+        json_object_set_new(d, "particles_per_rank", parts);
+        json_object_set_new(d, "owned_nodes_per_rank", nodes);
+        json_object_set_new(d, "particles_sent_per_rank", moved);
+        st = add_to_run_json(out_dir, "distributed", d);
+    }
+    free(v);
+    return st;
+}
+
 int run_simulation(const RunConfig *cfg, RunSummary *sum)
 {
     int status = MPM_OK;
@@ -435,6 +479,21 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     const char *solver_opts[RUN_MAX_SOLVER_OPTS];
     SessionConfig scfg;
     run_session_config(cfg, &scfg, solver_opts);
+    /* under mpirun the scene is split over the ranks (docs/distributed.md) */
+    scfg.distributed = under_mpi_launcher();
+    if (scfg.distributed) {
+        const char *other = cfg->vtk_dir         ? "--vtk"
+                            : cfg->particles_dir  ? "--particles"
+                            : cfg->trajectory     ? "--trajectory"
+                            : cfg->trajectory_ref ? "--trajectory-ref"
+                            : cfg->dt_from        ? "--dt-from"
+                            : cfg->error_ref      ? "--error-ref"
+                            : cfg->checkpoint_at  ? "--checkpoint-at"
+                            : cfg->from           ? "--from"
+                            : cfg->sample_frames  ? "--sample-frames"
+                                                  : NULL;
+        if (other) return mpm_error(MPM_EINPUT, "%s: not in a run over MPI ranks yet (docs/distributed.md)", other);
+    }
     SolveSettings set;
     run_solve_settings(cfg, &set);
     AccuracyConfig acfg = accuracy_config(cfg);
@@ -448,6 +507,10 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     const Scene *scene = &ses.scene;
     Simulation *sim = &ses.sim;
     int threads = ses.threads;
+    const int secondary = ses.has_comm && ses.comm.rank > 0; /* writes nothing, prints nothing */
+    RunConfig own = *cfg;
+    if (secondary) own.quiet = 1;
+    cfg = &own;
     if ((status = run_accuracy_create(&acfg, &acc))) {
         run_accuracy_free(&acc);
         session_close(&ses);
@@ -496,20 +559,22 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     }
 
     char out_dir[1024];
-    if (cfg->out_dir) snprintf(out_dir, sizeof out_dir, "%s", cfg->out_dir);
+    if (secondary) snprintf(out_dir, sizeof out_dir, "%s", SECONDARY_RANK_DIR);
+    else if (cfg->out_dir) snprintf(out_dir, sizeof out_dir, "%s", cfg->out_dir);
     else snprintf(out_dir, sizeof out_dir, "out/%s-%s", scene->name, solver->name);
     FILE *steps_csv = NULL, *frames_csv = NULL, *iters_csv = NULL;
     VtkSeries vtk;
     memset(&vtk, 0, sizeof vtk);
-    if ((status = paths_mkdir_p(out_dir))) goto done;
+    if (!secondary && (status = paths_mkdir_p(out_dir))) goto done;
     if (cfg->particles_dir && (status = paths_mkdir_p(cfg->particles_dir))) goto done;
     if (cfg->vtk_dir && (status = vtk_series_open(&vtk, cfg->vtk_dir, cfg->vtk_grid, cfg->vtk_grid_min_mass))) goto done;
     if (!(steps_csv = open_in(out_dir, "steps.csv", &status))) goto done;
     if (!(frames_csv = open_in(out_dir, "frames.csv", &status))) goto done;
     if (cfg->history && !(iters_csv = open_in(out_dir, "iters.csv", &status))) goto done;
     if ((status = run_accuracy_open(&acc, out_dir, scene))) goto done;
-    write_run_json(out_dir, cfg, scene, solver, &set, &acc, frames, n_samples ? samples[0] : sim->frame, threads,
-                   &status);
+    if (!secondary)
+        write_run_json(out_dir, cfg, scene, solver, &set, &acc, frames, n_samples ? samples[0] : sim->frame, threads,
+                       &status);
     if (status) goto done;
     fprintf(steps_csv, "scene,solver,frame,step,t,dt,particles,active_nodes,hessian_blocks,outer_iters,linear_iters,"
                        "ls_evals,residual,status,wall_s,p2g_s,assemble_s,setup_s,solve_s,linesearch_s,g2p_s,threads,"
@@ -534,13 +599,13 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
                "max_resid", "status");
     }
     RunOutput out = {cfg,     scene,   solver,      &acc, steps_csv, frames_csv, iters_csv, threads,
-                     cfg->vtk_dir ? &vtk : NULL, out_dir, fingerprint};
+                     cfg->vtk_dir ? &vtk : NULL, out_dir, fingerprint, ses.has_comm ? &ses.comm : NULL};
     FrameDriver driver = {.frames = frames,
                           .sample_frames = samples,
                           .n_samples = n_samples,
                           .restore = restore_sample,
                           .on_failure = cfg->on_failure,
-                          .progress = 1,
+                          .progress = !secondary,
                           .max_step_s = cfg->max_step_s,
                           .max_run_s = cfg->max_run_s,
                           .before_step = before_step,
@@ -554,11 +619,12 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     LoadWindow load;
     load_window_start(&load);
     if ((status = frame_driver_run(&driver, sim, solver, &set, &sum->totals, stop_reason, sizeof stop_reason))) goto done;
-    load_window_end(&load, threads);
+    /* over ranks on this machine, every rank's threads are the run's own */
+    load_window_end(&load, ses.has_comm ? threads * ses.comm.ranks : threads);
     fflush(steps_csv);
     fflush(frames_csv);
     const DriveTotals *tot = &sum->totals;
-    if (tot->stopped) fprintf(stderr, "mpmbench: run stopped: %s\n", stop_reason);
+    if (tot->stopped && !secondary) fprintf(stderr, "mpmbench: run stopped: %s\n", stop_reason);
     if (!cfg->quiet) {
         printf("total: %d frames, %d steps, %ld outer, %ld linear, %ld inner iterations, %.3f s wall (%.3f s/frame), "
                "worst status %s\n",
@@ -567,12 +633,14 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
         printf("wrote %s/steps.csv and %s/frames.csv%s\n", out_dir, out_dir, iters_csv ? " and iters.csv" : "");
     }
     /* a matrix cell's load is the runner's to report (cells.csv machine_busy) */
-    if (load.busy && !getenv("MPM_MATRIX_CELL"))
+    if (load.busy && !getenv("MPM_MATRIX_CELL") && !secondary)
         fprintf(stderr,
                 "mpmbench: warning: other processes used %.1f CPU-seconds of the run's %.1f s on %d cores while it "
                 "ran on %d thread%s: its times are not valid (machine_load in run.json; on a shared machine "
                 "run with fewer threads, or OMP_WAIT_POLICY=passive)\n",
                 load.others_cpu_s, load.elapsed_s, load.cores, threads, threads == 1 ? "" : "s");
+    if (ses.has_comm && (status = add_distribution(out_dir, &ses))) goto done;
+    if (secondary) goto done;
     if ((status = add_machine_load(out_dir, &load))) goto done;
     /* the parts' statistics through the view op: the hierarchy of the last
      * setup (HOT Fig. 8: blocks per row per level; none when every step
