@@ -155,14 +155,18 @@ static void load_window_start(LoadWindow *w)
     w->t0 = event_clock();
 }
 
-static void load_window_end(LoadWindow *w, int threads)
+/* comm: a run over ranks on this machine, whose every rank's CPU time is
+ * the run's own (collective) */
+static void load_window_end(LoadWindow *w, int threads, const CommOps *comm)
 {
     double busy1 = machine_busy_seconds(), cpu1 = process_cpu_seconds();
     w->elapsed_s = event_clock() - w->t0;
     w->cores = (int)sysconf(_SC_NPROCESSORS_ONLN);
     w->others_cpu_s = -1.0;
-    if (w->busy0 >= 0 && busy1 >= 0 && w->cpu0 >= 0 && cpu1 >= 0) {
-        w->others_cpu_s = (busy1 - w->busy0) - (cpu1 - w->cpu0);
+    double own[2] = {cpu1 - w->cpu0, w->cpu0 >= 0 && cpu1 >= 0 ? 0.0 : 1.0}; /* CPU seconds, a failed reading */
+    if (comm && comm->sum(comm->ctx, own, 2)) own[1] = 1.0;
+    if (w->busy0 >= 0 && busy1 >= 0 && own[1] == 0.0) {
+        w->others_cpu_s = (busy1 - w->busy0) - own[0];
         if (w->others_cpu_s < 0) w->others_cpu_s = 0.0; /* clock ticks of 10 ms against exact rusage */
     }
     w->busy = machine_was_busy(w->others_cpu_s, w->elapsed_s, threads, w->cores);
@@ -620,7 +624,8 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     load_window_start(&load);
     if ((status = frame_driver_run(&driver, sim, solver, &set, &sum->totals, stop_reason, sizeof stop_reason))) goto done;
     /* over ranks on this machine, every rank's threads are the run's own */
-    load_window_end(&load, ses.has_comm ? threads * ses.comm.ranks : threads);
+    const int run_threads = ses.has_comm ? threads * ses.comm.ranks : threads;
+    load_window_end(&load, run_threads, ses.has_comm ? &ses.comm : NULL);
     fflush(steps_csv);
     fflush(frames_csv);
     const DriveTotals *tot = &sum->totals;
@@ -638,7 +643,7 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
                 "mpmbench: warning: other processes used %.1f CPU-seconds of the run's %.1f s on %d cores while it "
                 "ran on %d thread%s: its times are not valid (machine_load in run.json; on a shared machine "
                 "run with fewer threads, or OMP_WAIT_POLICY=passive)\n",
-                load.others_cpu_s, load.elapsed_s, load.cores, threads, threads == 1 ? "" : "s");
+                load.others_cpu_s, load.elapsed_s, load.cores, run_threads, run_threads == 1 ? "" : "s");
     if (ses.has_comm && (status = add_distribution(out_dir, &ses))) goto done;
     if (secondary) goto done;
     if ((status = add_machine_load(out_dir, &load))) goto done;
