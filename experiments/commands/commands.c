@@ -13,6 +13,7 @@
 #include "experiments/bench/bench.h"
 #include "experiments/cli/run_settings.h"
 #include "experiments/dist/decompose_cmd.h"
+#include "experiments/io/mpi_launcher.h"
 #include "experiments/matrix/matrix_cmd.h"
 #include "experiments/render/render_cmd.h"
 #include "experiments/run/provenance.h"
@@ -285,6 +286,7 @@ static const Command *find_command(int argc, char **argv, int *words, int *statu
 
 int cli_main(int argc, char **argv)
 {
+    under_mpi_launcher(); /* read before anything starts MPI (mpi_launcher.h) */
     if (argc < 2) {
         cli_program_usage(stderr);
         return CLI_EXIT_INPUT;

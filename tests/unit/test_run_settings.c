@@ -55,7 +55,7 @@ static const char *sample(const Option *o, char *buf, size_t n)
         if (!strcmp(o->flag, "--solver")) return "hot";
         if (!strcmp(o->flag, "--error-ref")) return "auto";
         if (o->flags & OPT_KEY_DIR) return "assets";
-        if (!strcmp(o->flag, "--checkpoint-at")) return "3,5";
+        if (!strcmp(o->flag, "--checkpoint-at") || !strcmp(o->flag, "--sample-frames")) return "3,5";
         snprintf(buf, n, "value-of%s", o->flag);
         return buf;
     case OPT_LIST:
