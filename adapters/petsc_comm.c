@@ -36,7 +36,7 @@ static int mpi_status(int code, const char *what)
     return mpm_error(MPM_EINTERNAL, "petsc communication: %s failed (%.*s)", what, len, text);
 }
 
-static int comm_agree(void *ctx, int status, int *agreed)
+static int mpi_agree(void *ctx, int status, int *agreed)
 {
     PetscComm *c = ctx;
     return mpi_status(MPI_Allreduce(&status, agreed, 1, MPI_INT, MPI_MAX, c->comm), "MPI_Allreduce");
@@ -149,7 +149,7 @@ static int halo_ready(PetscComm *c, int width, PetscSF *sf)
         /* SF creation is collective: a rank out of memory still agrees first */
         PetscSFNode *remote = malloc(sizeof(PetscSFNode) * (need ? need : 1));
         int mine = remote ? MPM_OK : MPM_EINTERNAL, all = MPM_OK;
-        int st = comm_agree(c, mine, &all);
+        int st = mpi_agree(c, mine, &all);
         if (st || all) {
             free(remote);
             return st ? st
@@ -224,7 +224,7 @@ int petsc_comm_open(CommOps *ops)
     *ops = (CommOps){.ctx = c,
                      .rank = c->rank,
                      .ranks = c->ranks,
-                     .agree = comm_agree,
+                     .agree = mpi_agree,
                      .sum = comm_sum,
                      .max = comm_max,
                      .exchange = comm_exchange,

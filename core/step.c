@@ -141,13 +141,7 @@ static int check_node_masses(const Simulation *sim)
 /* Over MPI ranks: every rank's worst status, so all stop together when one
  * fails (its own message, or "another rank failed"); st itself on one
  * process. */
-static int ranks_agree(const Simulation *sim, int st)
-{
-    if (!sim->comm) return st;
-    int all = MPM_OK, cst = sim->comm->agree(sim->comm->ctx, st, &all);
-    if (cst || st) return cst ? cst : st;
-    return all ? mpm_error(all, "another rank failed (rank %d stops with it)", sim->comm->rank) : MPM_OK;
-}
+static int ranks_agree(const Simulation *sim, int st) { return sim->comm ? comm_agree(sim->comm, st) : st; }
 
 int step_begin(Simulation *sim)
 {

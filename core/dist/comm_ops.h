@@ -49,6 +49,12 @@ typedef struct {
     void (*close)(void *ctx);
 } CommOps;
 
+/* The agreement every collective phase ends with: every rank's worst
+ * status. Returns this rank's own failure, or one recorded as "another rank
+ * failed" when only another rank failed, or the agreement's own failure;
+ * MPM_OK when every rank succeeded. Collective. */
+int comm_agree(const CommOps *comm, int status);
+
 /* One rank: reductions return their input, the halo has no ghost (a plan
  * with ghosts is MPM_EINTERNAL), exchange copies the items to itself. */
 const CommOps *comm_serial(void);

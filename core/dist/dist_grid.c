@@ -23,18 +23,6 @@ static void unpack_node(uint64_t k, int c[3])
     c[2] = (int)(k & KEY_MASK) - KEY_OFFSET;
 }
 
-/* Every rank's worst status: this rank's own, or, when only another rank
- * failed, a failure that says so (every rank then stops together). */
-static int agree(const CommOps *comm, int status)
-{
-    int all = MPM_OK;
-    int st = comm->agree(comm->ctx, status, &all);
-    if (st) return st;
-    if (status) return status;
-    if (all) return mpm_error(all, "another rank failed (rank %d stops with it)", comm->rank);
-    return MPM_OK;
-}
-
 static int grow(DistGrid *dg, int nodes, int ghosts)
 {
     if (nodes > dg->cap_nodes) {
@@ -83,7 +71,7 @@ int dist_grid_build(DistGrid *dg, const Decomposition *d, const CommOps *comm, G
             if (o != me) ghost_key[offset[o]++] = pack_node(g->coord + 3 * (size_t)i);
         }
     }
-    if ((status = agree(comm, status))) goto done;
+    if ((status = comm_agree(comm, status))) goto done;
     if ((status = comm->exchange(comm->ctx, send_counts, ghost_key, recv_counts, &asked))) goto done;
 
     /* the nodes others asked for that this rank owns and has not got */
@@ -110,7 +98,7 @@ int dist_grid_build(DistGrid *dg, const Decomposition *d, const CommOps *comm, G
         unpack_node(asked[j], c);
         answer[j] = (uint64_t)grid_lookup(g, c);
     }
-    if ((status = agree(comm, status))) goto done;
+    if ((status = comm_agree(comm, status))) goto done;
     /* the answers go back in the order asked: recv_counts items to each rank */
     int *back_counts = send_counts; /* what each owner answers this rank: as many as it asked */
     if ((status = comm->exchange(comm->ctx, recv_counts, answer, back_counts, &owner_ids))) goto done;
@@ -134,8 +122,8 @@ int dist_grid_build(DistGrid *dg, const Decomposition *d, const CommOps *comm, G
         dg->n_extra = n_extra;
         dg->plan = (HaloPlan){n_ghosts, dg->ghost_node, dg->owner_rank, dg->owner_node};
     }
-    if ((status = agree(comm, status))) goto done;
-    status = agree(comm, comm->halo_plan(comm->ctx, &dg->plan, g->n));
+    if ((status = comm_agree(comm, status))) goto done;
+    status = comm_agree(comm, comm->halo_plan(comm->ctx, &dg->plan, g->n));
 done:
     free(send_counts);
     free(recv_counts);

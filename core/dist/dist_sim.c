@@ -40,11 +40,7 @@ int sim_distribute(Simulation *sim, const CommOps *comm)
     free(base);
     free(perm);
     free(scratch);
-    int all = MPM_OK;
-    int cst = comm->agree(comm->ctx, st, &all);
-    if (cst) return cst;
-    if (st) return st;
-    if (all) return mpm_error(all, "another rank failed (rank %d stops with it)", comm->rank);
+    if ((st = comm_agree(comm, st))) return st;
     sim->comm = comm;
     return MPM_OK;
 }
@@ -56,10 +52,9 @@ int dist_p2g_halo(Simulation *sim)
     const unsigned char *owned = sim->dist.owned;
     double *mom = malloc(sizeof(double) * 3 * (size_t)(g->n ? g->n : 1));
     int st = mom ? MPM_OK : mpm_error(MPM_EINTERNAL, "out of memory: %d nodes' momentum", g->n);
-    int all = MPM_OK, cst = c->agree(c->ctx, st, &all);
-    if (cst || st || all) {
+    if ((st = comm_agree(c, st))) {
         free(mom);
-        return cst ? cst : st ? st : mpm_error(all, "another rank failed (rank %d stops with it)", c->rank);
+        return st;
     }
     /* this rank's momentum (P2G left v = momentum / mass; a node only others reach has neither) */
     for (int i = 0; i < g->n; ++i)
@@ -149,10 +144,8 @@ int dist_migrate(Simulation *sim, size_t *sent)
             pack_particle(p, k, send + at[dest[k]]);
             at[dest[k]] += W;
         }
-    int all = MPM_OK, cst = c->agree(c->ctx, st, &all);
-    if (!cst && !st && all) st = mpm_error(all, "another rank failed (rank %d stops with it)", me);
-    if (!cst && !st) cst = c->exchange(c->ctx, send_counts, send, recv_counts, &recv);
-    if (!st) st = cst;
+    st = comm_agree(c, st);
+    if (!st) st = c->exchange(c->ctx, send_counts, send, recv_counts, &recv);
     if (!st) { /* the staying particles in their order, then the arrivals rank after rank */
         size_t kept = 0, arriving = 0;
         for (size_t k = 0; k < n; ++k)
