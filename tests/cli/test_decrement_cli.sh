@@ -20,7 +20,8 @@ for case in "stretched-box 5" "bar3 6"; do
     out="$tmp/$1-$solver"
     "$bin" run --scene "$1" --scale "$2" --frames 1 --threads 2 --quiet --solver "$solver:stop=decrement" \
       --eps "$eps" --error-ref auto --out "$out" >/dev/null 2>"$tmp/err"
-    check "$1 $solver: exit 0 ($(head -c 300 "$tmp/err"))" test $? -eq 0
+    rc=$?  # before the description's $(...), which resets $?
+    check "$1 $solver: exit 0 ($(head -c 300 "$tmp/err"))" test $rc -eq 0
     python3 - "$out/steps.csv" "$eps" "$C" >"$tmp/gap" 2>&1 <<'PY'
 import csv, sys
 eps, C = float(sys.argv[2]), float(sys.argv[3])

@@ -7,7 +7,8 @@
 
 m="$src/experiments/matrices"
 "$bin" matrix run "$m/gast15-table1.json" --dry-run --out "$tmp/t1" >"$tmp/t1.txt" 2>&1
-check "gast15-table1 validates ($(tail -1 "$tmp/t1.txt"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "gast15-table1 validates ($(tail -1 "$tmp/t1.txt"))" test $rc -eq 0
 check "gast15-table1: 26 cells" grep -q ": 26 cells" "$tmp/t1.txt"
 check "gast15-table1: bar3 at E_mid 1e9" python3 -c "import json, sys; sys.exit(json.load(open('$m/gast15-table1.json'))['scenes']['bar3']['set']['materials.middle.E'] != 1e9)"
 for tau in 1e-1 1e-2 1e-4 1e-5; do
@@ -15,7 +16,8 @@ for tau in 1e-1 1e-2 1e-4 1e-5; do
 done
 
 "$bin" matrix run "$m/gast15-fig18.json" --dry-run --out "$tmp/f18" >"$tmp/f18.txt" 2>&1
-check "gast15-fig18 validates ($(tail -1 "$tmp/f18.txt"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "gast15-fig18 validates ($(tail -1 "$tmp/f18.txt"))" test $rc -eq 0
 check "gast15-fig18: 12 cells" grep -q ": 12 cells" "$tmp/f18.txt"
 check "semi-implicit on snowball-drop at CFL 2.4" grep -q "snowball-drop/semi-implicit .*solver_setting=cfl 2.4" "$tmp/f18.txt"
 check "semi-implicit on snowball-wall at CFL 3.0" grep -q "snowball-wall/semi-implicit .*solver_setting=cfl 3.0" "$tmp/f18.txt"

@@ -18,7 +18,8 @@ for pair in scenes:experiments/scenes matrices:experiments/matrices scripts:scri
 done
 
 cmake --install "$build" --prefix "$tmp/inst" >"$tmp/install.txt" 2>&1
-check "cmake --install exit 0 ($(tail -1 "$tmp/install.txt"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "cmake --install exit 0 ($(tail -1 "$tmp/install.txt"))" test $rc -eq 0
 inst="$tmp/inst/bin/mpmbench"
 mkdir -p "$tmp/elsewhere"
 cd "$tmp/elsewhere" || exit 1
@@ -26,12 +27,14 @@ unset MPM_SCENE_DIR MPM_SCRIPT_DIR
 export GIT_CEILING_DIRECTORIES="$tmp" # $tmp may lie inside a checkout: git must not look above it
 
 "$inst" list scenes >"$tmp/scenes.txt" 2>&1
-check "list scenes exit 0 ($(head -1 "$tmp/scenes.txt"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "list scenes exit 0 ($(head -1 "$tmp/scenes.txt"))" test $rc -eq 0
 n_src=$(find "$src/experiments/scenes" -maxdepth 1 -name '*.json' | wc -l)
 check "list scenes: the $n_src built-in scenes" test "$(grep -c '^[a-z]' "$tmp/scenes.txt")" -eq "$n_src"
 
 "$inst" run --scene drop --solver pn-pcg --scale 4 --frames 1 --quiet --out "$tmp/elsewhere/run" 2>"$tmp/run.err"
-check "run --scene drop exit 0 ($(head -c 200 "$tmp/run.err"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "run --scene drop exit 0 ($(head -c 200 "$tmp/run.err"))" test $rc -eq 0
 check "run --scene drop: steps.csv" test -s "$tmp/elsewhere/run/steps.csv"
 
 "$inst" matrix run smoke --dry-run >"$tmp/dry.txt" 2>&1
@@ -43,13 +46,15 @@ cat >"$tmp/tiny.json" <<'EOF'
  "axes": {"scene": ["drop"], "solver": ["pn-pcg", "hot"]}, "baseline": "pn-pcg"}
 EOF
 "$inst" matrix run "$tmp/tiny.json" --out "$tmp/m" >"$tmp/m.txt" 2>&1
-check "matrix run exit 0 ($(tail -1 "$tmp/m.txt"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "matrix run exit 0 ($(tail -1 "$tmp/m.txt"))" test $rc -eq 0
 check "provenance: the checkout of the working directory (none here)" python3 -c "
 import json, sys
 c = json.load(open(sys.argv[1]))['invocations'][0]['checkout']
 sys.exit(not (c['commit'].startswith('unknown') and c['path'] == sys.argv[2]))" "$tmp/m/provenance.json" "$tmp/elsewhere"
 "$inst" matrix report "$tmp/m" >"$tmp/report.txt" 2>&1
-check "matrix report with the installed scripts exit 0 ($(tail -1 "$tmp/report.txt"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "matrix report with the installed scripts exit 0 ($(tail -1 "$tmp/report.txt"))" test $rc -eq 0
 check "matrix report: report.md" test -s "$tmp/m/report.md"
 check "the installed scripts write no __pycache__" test -z "$(find "$tmp/inst" -name __pycache__)"
 finish

@@ -35,7 +35,8 @@ done
 
 for s in pn-gamg-pcg lbfgs-gamg; do
   "$bin" "${run[@]}" --solver $s --out "$tmp/$s" >"$tmp/$s.log" 2>&1
-  check "$s runs: exit 0 ($(tail -1 "$tmp/$s.log"))" test $? -eq 0
+  rc=$?  # before the description's $(...), which resets $?
+  check "$s runs: exit 0 ($(tail -1 "$tmp/$s.log"))" test $rc -eq 0
 done
 python3 - "$tmp/pn-gamg-pcg" >"$tmp/json.txt" 2>&1 <<'PY'
 import csv, json, sys
@@ -59,9 +60,11 @@ check "run.json: PETSc's version, the options with their defaults, PETSc's KSPVi
 # and line-search evaluations, step by step
 hot=(run --scene bar3 --scale 3 --frames 2 --quiet)
 "$bin" "${hot[@]}" --solver hot-petsc --out "$tmp/hot-petsc" >"$tmp/hp.log" 2>&1
-check "hot-petsc runs: exit 0 ($(tail -1 "$tmp/hp.log"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "hot-petsc runs: exit 0 ($(tail -1 "$tmp/hp.log"))" test $rc -eq 0
 "$bin" "${hot[@]}" --solver hot:smoother_precision=double --out "$tmp/hot" >"$tmp/h.log" 2>&1
-check "hot (double) runs: exit 0 ($(tail -1 "$tmp/h.log"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "hot (double) runs: exit 0 ($(tail -1 "$tmp/h.log"))" test $rc -eq 0
 python3 - "$tmp/hot-petsc" "$tmp/hot" >"$tmp/agree.txt" 2>&1 <<'PY'
 import csv, sys
 a, b = (list(csv.DictReader(open(f"{d}/steps.csv"))) for d in sys.argv[1:3])

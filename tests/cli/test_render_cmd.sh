@@ -35,30 +35,36 @@ png_is() { [ "$(png_size "$1")" = "$2 $3" ] || { echo "  $1: $(png_size "$1"), w
 
 # frame 0 of drop, default name <scene>.png in the working directory
 (cd "$tmp" && "$bin" render --scene drop --scale 4 >"$tmp/drop.out" 2>"$tmp/drop.err")
-check "render drop exit 0 ($(cat "$tmp/drop.err"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "render drop exit 0 ($(cat "$tmp/drop.err"))" test $rc -eq 0
 check "drop.png written in the working directory" png_ok "$tmp/drop.png" 100 2000
 check "render prints the file it wrote" grep -q "drop.png" "$tmp/drop.out"
 
 # bar3, explicit output, views and colouring
 "$bin" render --scene bar3 --scale 4 --out "$tmp/bar3.png" >/dev/null 2>"$tmp/err"
-check "render bar3 exit 0 ($(cat "$tmp/err"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "render bar3 exit 0 ($(cat "$tmp/err"))" test $rc -eq 0
 check "bar3.png is a sane PNG" png_ok "$tmp/bar3.png" 100 2000
 wh=$(png_size "$tmp/bar3.png")
 check "bar3 front view is taller than wide ($wh)" test "${wh#* }" -gt "${wh% *}"
 "$bin" render --scene bar3 --scale 4 --view iso --color speed --width 320 --height 240 --out "$tmp/iso.png" >/dev/null 2>"$tmp/err"
-check "render bar3 iso exit 0 ($(cat "$tmp/err"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "render bar3 iso exit 0 ($(cat "$tmp/err"))" test $rc -eq 0
 check "--width/--height give the image size" png_is "$tmp/iso.png" 320 240
 "$bin" render --scene drop --scale 4 --view top --width 300 --out "$tmp/top.png" --set materials.soft.E=2e5 >/dev/null 2>"$tmp/err"
-check "render with --width only and --set exit 0 ($(cat "$tmp/err"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "render with --width only and --set exit 0 ($(cat "$tmp/err"))" test $rc -eq 0
 wh=$(png_size "$tmp/top.png")
 check "--width alone sets the width ($wh)" test "${wh% *}" = 300
 "$bin" render --scene "$src/experiments/scenes/drop.json" --scale 4 --view side --out "$tmp/file.png" >/dev/null 2>"$tmp/err"
-check "render a scene file exit 0 ($(cat "$tmp/err"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "render a scene file exit 0 ($(cat "$tmp/err"))" test $rc -eq 0
 check "scene file picture" png_ok "$tmp/file.png" 100 2000
 
 # frame 1: simulated with a solver, then drawn
 "$bin" render --scene drop --scale 4 --frame 1 --solver pn-pcg-mf --threads 1 --out "$tmp/f1.png" >"$tmp/f1.out" 2>"$tmp/err"
-check "render frame 1 exit 0 ($(cat "$tmp/err"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "render frame 1 exit 0 ($(cat "$tmp/err"))" test $rc -eq 0
 check "frame 1 picture" png_ok "$tmp/f1.png" 100 2000
 check "frame 1 is at t = 1/24 s" grep -q "t = 0.04167 s" "$tmp/f1.out"
 

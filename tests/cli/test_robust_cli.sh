@@ -66,7 +66,8 @@ expect_input_error "colliders.1.motion.0: collider \"top_cap\" moves at a non-fi
 # --- a particle reaching a domain wall stays in the domain (F = 0.01 I explodes the box) ---
 "$bin" run --scene drop --solver pn-pcg --scale 2 --frames 2 --quiet --out "$tmp/boom" \
   --set 'objects.0.initial_F={"type":"random_diagonal","min":0.01,"max":0.01}' 2>"$tmp/boom.err"
-check "exploding box with domain walls: exit 0 ($(cat "$tmp/boom.err"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "exploding box with domain walls: exit 0 ($(cat "$tmp/boom.err"))" test $rc -eq 0
 
 # --- the reference CFL rule (SPEC 12) on bar3 at dx 0.0075 -----------------
 # the thin bar keeps the run small; the collider speed sets dt

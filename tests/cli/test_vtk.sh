@@ -16,10 +16,12 @@ py=${MPM_PYTHON:-/usr/bin/python3}
 "$py" -c "import vtk" 2>/dev/null || skip "$py has no vtk module (Debian: python3-vtk9; scripts/test.sh installs it)"
 "$bin" run --scene stretched-box --solver pn-pcg --scale 5 --frames 2 --quiet --out "$tmp/run" \
   --set objects.0.initial_F.per_particle=true --particles "$tmp/ply" --vtk "$tmp/vtk" --vtk-grid 2>"$tmp/err"
-check "run --vtk exit 0 ($(head -c 200 "$tmp/err"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "run --vtk exit 0 ($(head -c 200 "$tmp/err"))" test $rc -eq 0
 "$bin" run --scene stretched-box --solver pn-pcg --scale 5 --frames 2 --quiet --out "$tmp/run0" \
   --set objects.0.initial_F.per_particle=true --vtk "$tmp/vtk0" --vtk-grid --vtk-grid-min-mass 0 2>"$tmp/err0"
-check "run --vtk-grid-min-mass 0: exit 0 ($(head -c 200 "$tmp/err0"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "run --vtk-grid-min-mass 0: exit 0 ($(head -c 200 "$tmp/err0"))" test $rc -eq 0
 check "the files" test -s "$tmp/vtk/particles.pvd" -a -s "$tmp/vtk/particles_0000.vtp" -a -s "$tmp/vtk/particles_0002.vtp" \
   -a -s "$tmp/vtk/grid.pvd" -a -s "$tmp/vtk/grid_0001.vtp" -a ! -e "$tmp/vtk/grid_0000.vtp"
 "$py" - "$tmp" >"$tmp/check.txt" 2>&1 <<'PY'

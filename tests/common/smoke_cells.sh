@@ -5,7 +5,8 @@ smoke() { # matrix file, expected cell count, more matrix run options
   local name
   name=$(basename "$1" .json)
   "$bin" matrix run "$1" --only '*/hot' --out "$tmp/$name" "${@:3}" >"$tmp/$name.txt" 2>&1
-  check "$name: matrix run exit 0 ($(tail -1 "$tmp/$name.txt"))" test $? -eq 0
+  rc=$?  # before the description's $(...), which resets $?
+  check "$name: matrix run exit 0 ($(tail -1 "$tmp/$name.txt"))" test $rc -eq 0
   python3 - "$tmp/$name/cells.csv" "$2" >"$tmp/$name.check" 2>&1 <<'PY'
 import csv, sys
 rows = list(csv.DictReader(open(sys.argv[1])))

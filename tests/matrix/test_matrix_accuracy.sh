@@ -106,7 +106,8 @@ check "plain matrix: the id it always had" grep -q "^bd1ff00e495e  todo  drop/ho
 if command -v mpirun >/dev/null; then
   mpirun_ranks -np 2 "$bin" matrix run "$tmp/m.json" --out "$tmp/mpi" \
     >"$tmp/mpi.txt" 2>"$tmp/mpi.err"
-  check "mpirun -np 2: exit 0 ($(head -c 300 "$tmp/mpi.err"))" test $? -eq 0
+  rc=$?  # before the description's $(...), which resets $?
+  check "mpirun -np 2: exit 0 ($(head -c 300 "$tmp/mpi.err"))" test $rc -eq 0
   check "mpirun: all 9 cells ok" test "$(col "$tmp/mpi/cells.csv" status | grep -c ok)" -eq 9
   m="$tmp/mpi/cells"
   for id in $(col "$tmp/mpi/cells.csv" id scene bar3); do

@@ -100,7 +100,8 @@ check "every failing cell printed" test "$(grep -c '^check: FAIL ' "$tmp/out.txt
 check "the check.csv header" grep -qx "id,scene,solver,eps,k,pass,reasons" "$tmp/r/check.csv"
 
 "$bin" matrix report "$tmp/r" >/dev/null 2>"$tmp/rep.err"
-check "report: exit 0 ($(head -c 200 "$tmp/rep.err"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "report: exit 0 ($(head -c 200 "$tmp/rep.err"))" test $rc -eq 0
 check "report: grid row of a failing case" grep -q "^| drop k=rise | \*\*FAIL\*\* |$" "$tmp/r/report.md"
 check "report: grid row of a passing case" grep -q "^| drop k=ok | pass |$" "$tmp/r/report.md"
 check "report: passed per solver" grep -q "^| \*\*passed\*\* | 2/10 |$" "$tmp/r/report.md"

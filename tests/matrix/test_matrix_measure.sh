@@ -42,7 +42,8 @@ m["scenes"]["drop"]["max_run_seconds"] = 1e-6  # any step exhausts it, on any ma
 json.dump(m, open(sys.argv[1], "w"))
 PY
 "$bin" matrix run "$tmp/m.json" --out "$tmp/res" >"$tmp/run.txt" 2>"$tmp/run.err"
-check "matrix run exit 0 ($(head -c 300 "$tmp/run.err"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "matrix run exit 0 ($(head -c 300 "$tmp/run.err"))" test $rc -eq 0
 cells="$tmp/res/cells.csv"
 ids=$(python3 -c 'import csv,sys; print(" ".join(r["id"] for r in csv.DictReader(open(sys.argv[1]))))' "$cells")
 check "repeat 2: four rows ($ids)" test "$(echo $ids | wc -w)" -eq 4

@@ -18,7 +18,8 @@ check "every cell ended ok (no crash, no kill)" python3 -c "
 import csv, sys; sys.exit(not {r['status'] for r in csv.DictReader(open('$tmp/s/cells.csv'))} <= {'ok', 'time-limit'})"
 check "the summary line" grep -q "^check: $n of $n cells passed" "$tmp/out.txt"
 "$bin" matrix report "$tmp/s" >/dev/null 2>"$tmp/rep.err"
-check "report: exit 0 ($(head -c 200 "$tmp/rep.err"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "report: exit 0 ($(head -c 200 "$tmp/rep.err"))" test $rc -eq 0
 check "report: the robustness grid" grep -q "^### Robustness (matrix run --check)" "$tmp/s/report.md"
 check "report: the robustness answer first" test "$(sed -n 3p "$tmp/s/report.md" | cut -c1-14)" = "- Robustness: "
 check "report: passed per solver" grep -q "^| \*\*passed\*\* | 24/24 | 24/24 | 24/24 | 24/24 |" "$tmp/s/report.md"

@@ -14,7 +14,8 @@ cat >"$tmp/m.json" <<'JSON'
  "axes": {"solver": ["pn-pcg", "hot:window=4"]}, "repeat": 2}
 JSON
 "$bin" matrix run "$tmp/m.json" --out "$tmp/res" >"$tmp/run.txt" 2>&1
-check "matrix run ($(tail -2 "$tmp/run.txt"))" test $? -eq 0
+rc=$?  # before the description's $(...), which resets $?
+check "matrix run ($(tail -2 "$tmp/run.txt"))" test $rc -eq 0
 python3 - "$src/scripts" "$tmp/res" <<'PY' >"$tmp/hash.txt" 2>&1
 import csv, json, os, sys
 sys.path.insert(0, sys.argv[1])
