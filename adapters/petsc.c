@@ -43,6 +43,7 @@
 #include "adapters/mpi_startup.h"
 #include "adapters/petsc_error.h"
 #include "adapters/petsc_hierarchy.h"
+#include "core/dist/node_numbering.h"
 #include "core/error.h"
 #include "solvers/mg/mg.h"
 
@@ -85,6 +86,22 @@ typedef struct {
     const Projection *proj;
     double *r_proj;
     int64_t cap_r;
+    /* Across ranks (docs/distributed.md): the last setup's split. The Mat
+     * and vectors are PETSc's parallel ones over the owned nodes, numbered
+     * by dist_node_numbering; rows come from every rank's part of the
+     * Hessian (ghost rows too) through MatSetValuesBlocked with ADD_VALUES,
+     * PETSc's assembly moving the off-rank blocks to their owners. */
+    int dist;
+    const CommOps *comm;
+    const unsigned char *owned;
+    NodeNumbering num;
+    int *gid; /* per local node: its global number */
+    int cap_gid;
+    PetscInt *row_cols; /* one block row's global columns */
+    PetscScalar *row_vals; /* and its values, 3 x 3len row-major */
+    int64_t cap_row;
+    double *r_owned, *z_owned; /* the owned nodes' entries, packed */
+    int64_t cap_owned;
 } Petsc;
 
 /* ---- start-up, errors ---- */
@@ -345,8 +362,9 @@ static int set_near_null_space(Petsc *s, int n, const int *coord)
 static int build_solver(Petsc *s, int status)
 {
     destroy_solver(s);
-    const int N = 3 * s->n;
-    int st = pk(KSPCreate(PETSC_COMM_SELF, &s->ksp), MPM_EINTERNAL, "KSPCreate");
+    const int N = 3 * (s->dist ? s->num.n_owned : s->n);
+    const MPI_Comm comm = s->dist ? PETSC_COMM_WORLD : PETSC_COMM_SELF;
+    int st = pk(KSPCreate(comm, &s->ksp), MPM_EINTERNAL, "KSPCreate");
     if (!st) st = pk(KSPSetOptionsPrefix(s->ksp, s->prefix), MPM_EINTERNAL, "KSPSetOptionsPrefix");
     if (!st) st = pk(KSPSetOperators(s->ksp, s->A, s->A), MPM_EINTERNAL, "KSPSetOperators");
     /* a zero guess: apply is M r, not a correction of z's old contents */
@@ -358,8 +376,13 @@ static int build_solver(Petsc *s, int status)
     if (!st && s->hier) st = petsc_hierarchy_configure(s->hier, pc);
     if (!st) st = pk(KSPSetUp(s->ksp), status == MPM_EINPUT ? MPM_EINPUT : MPM_ENUMERIC, "KSPSetUp");
     /* vectors without storage: apply places the caller's arrays */
-    if (!st) st = pk(VecCreateSeqWithArray(PETSC_COMM_SELF, 3, N, NULL, &s->b), MPM_EINTERNAL, "VecCreateSeqWithArray");
-    if (!st) st = pk(VecCreateSeqWithArray(PETSC_COMM_SELF, 3, N, NULL, &s->x), MPM_EINTERNAL, "VecCreateSeqWithArray");
+    if (!st && s->dist) {
+        st = pk(VecCreateMPIWithArray(comm, 3, N, PETSC_DECIDE, NULL, &s->b), MPM_EINTERNAL, "VecCreateMPIWithArray");
+        if (!st) st = pk(VecCreateMPIWithArray(comm, 3, N, PETSC_DECIDE, NULL, &s->x), MPM_EINTERNAL, "VecCreateMPIWithArray");
+    } else if (!st) {
+        st = pk(VecCreateSeqWithArray(comm, 3, N, NULL, &s->b), MPM_EINTERNAL, "VecCreateSeqWithArray");
+        if (!st) st = pk(VecCreateSeqWithArray(comm, 3, N, NULL, &s->x), MPM_EINTERNAL, "VecCreateSeqWithArray");
+    }
     if (st) {
         destroy_solver(s);
         return st;
@@ -373,6 +396,7 @@ static int build_solver(Petsc *s, int status)
 static int setup_on(Petsc *s, const Bsr *H, const int *coord, const NodeColoring *coloring, int status)
 {
     destroy_solver(s);
+    s->dist = 0;
     s->coord = coord;
     s->coloring = coloring;
     int st = set_options(s);
@@ -381,6 +405,182 @@ static int setup_on(Petsc *s, const Bsr *H, const int *coord, const NodeColoring
     if (!st) st = set_near_null_space(s, H->n, coord);
     if (!st) st = build_solver(s, status);
     return st;
+}
+
+/* ---- across ranks ---- */
+
+/* Room for the numbering, one block row and the packed owned vectors. */
+static int reserve_ranks(Petsc *s, const Bsr *H)
+{
+    if (H->n > s->cap_gid) {
+        int *p = realloc(s->gid, sizeof(int) * (size_t)H->n);
+        if (!p) return mpm_error(MPM_EINTERNAL, "out of memory: petsc node numbers (%d nodes)", H->n);
+        s->gid = p;
+        s->cap_gid = H->n;
+    }
+    int64_t row = 1;
+    for (int i = 0; i < H->n; ++i) row = H->row_ptr[i + 1] - H->row_ptr[i] > row ? H->row_ptr[i + 1] - H->row_ptr[i] : row;
+    if (row > s->cap_row) {
+        PetscInt *c = realloc(s->row_cols, sizeof(PetscInt) * (size_t)row);
+        if (c) s->row_cols = c;
+        PetscScalar *v = c ? realloc(s->row_vals, sizeof(PetscScalar) * 9 * (size_t)row) : NULL;
+        if (!v) return mpm_error(MPM_EINTERNAL, "out of memory: petsc block row (%lld blocks)", (long long)row);
+        s->row_vals = v;
+        s->cap_row = row;
+    }
+    if (3 * (int64_t)H->n > s->cap_owned) {
+        double *r = realloc(s->r_owned, sizeof(double) * 3 * (size_t)H->n);
+        if (r) s->r_owned = r;
+        double *z = r ? realloc(s->z_owned, sizeof(double) * 3 * (size_t)H->n) : NULL;
+        if (!z) return mpm_error(MPM_EINTERNAL, "out of memory: petsc owned vectors (%d nodes)", H->n);
+        s->z_owned = z;
+        s->cap_owned = 3 * (int64_t)H->n;
+    }
+    return MPM_OK;
+}
+
+/* Block row i of H with global columns into s->row_cols and, when values,
+ * its blocks into s->row_vals as MatSetValuesBlocked reads them (row
+ * oriented: the three scalar rows of the block row, each across every
+ * block); returns the block count. */
+static PetscInt gather_row(Petsc *s, const Bsr *H, int i, int values)
+{
+    const int64_t k0 = H->row_ptr[i], len = H->row_ptr[i + 1] - k0;
+    for (int64_t k = 0; k < len; ++k) {
+        s->row_cols[k] = s->gid[H->col[k0 + k]];
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c)
+                s->row_vals[3 * len * r + 3 * k + c] = values ? H->val[9 * (k0 + k) + 3 * r + c] : 0.0;
+    }
+    return (PetscInt)len;
+}
+
+/* Every rank's part of H into A: ghost rows' blocks go to their owners in
+ * PETSc's assembly, where they are added to the owner's own. */
+static int fill_values_ranks(Petsc *s, const Bsr *H)
+{
+    int st = pk(MatZeroEntries(s->A), MPM_EINTERNAL, "MatZeroEntries");
+    for (int i = 0; i < H->n && !st; ++i) {
+        const PetscInt row = s->gid[i], len = gather_row(s, H, i, 1);
+        st = pk(MatSetValuesBlocked(s->A, 1, &row, len, s->row_cols, s->row_vals, ADD_VALUES), MPM_EINTERNAL,
+                "MatSetValuesBlocked");
+    }
+    if (!st) st = pk(MatAssemblyBegin(s->A, MAT_FINAL_ASSEMBLY), MPM_EINTERNAL, "MatAssemblyBegin");
+    if (!st) st = pk(MatAssemblyEnd(s->A, MAT_FINAL_ASSEMBLY), MPM_EINTERNAL, "MatAssemblyEnd");
+    return st;
+}
+
+/* A parallel Mat (MATBAIJ or MATAIJ of block size 3: MPI or Seq by the
+ * rank count) over the owned rows, its nonzero structure the union of
+ * every rank's pattern (counted by a MATPREALLOCATOR pass, so no row is
+ * under- or over-allocated). */
+static int build_structure_ranks(Petsc *s, const Bsr *H)
+{
+    destroy_matrix(s);
+    const PetscInt local = 3 * s->num.n_owned, global = 3 * s->num.total;
+    Mat pre = NULL;
+    int st = pk(MatCreate(PETSC_COMM_WORLD, &pre), MPM_EINTERNAL, "MatCreate");
+    if (!st) st = pk(MatSetType(pre, MATPREALLOCATOR), MPM_EINTERNAL, "MatSetType");
+    if (!st) st = pk(MatSetSizes(pre, local, local, global, global), MPM_EINTERNAL, "MatSetSizes");
+    if (!st) st = pk(MatSetBlockSize(pre, 3), MPM_EINTERNAL, "MatSetBlockSize");
+    if (!st) st = pk(MatSetUp(pre), MPM_EINTERNAL, "MatSetUp");
+    for (int i = 0; i < H->n && !st; ++i) {
+        const PetscInt row = s->gid[i], len = gather_row(s, H, i, 0);
+        st = pk(MatSetValuesBlocked(pre, 1, &row, len, s->row_cols, s->row_vals, INSERT_VALUES), MPM_EINTERNAL,
+                "MatSetValuesBlocked");
+    }
+    if (!st) st = pk(MatAssemblyBegin(pre, MAT_FINAL_ASSEMBLY), MPM_EINTERNAL, "MatAssemblyBegin");
+    if (!st) st = pk(MatAssemblyEnd(pre, MAT_FINAL_ASSEMBLY), MPM_EINTERNAL, "MatAssemblyEnd");
+    if (!st) st = pk(MatCreate(PETSC_COMM_WORLD, &s->A), MPM_EINTERNAL, "MatCreate");
+    if (!st) st = pk(MatSetSizes(s->A, local, local, global, global), MPM_EINTERNAL, "MatSetSizes");
+    if (!st) st = pk(MatSetType(s->A, s->baij ? MATBAIJ : MATAIJ), MPM_EINTERNAL, "MatSetType");
+    if (!st) st = pk(MatSetBlockSize(s->A, 3), MPM_EINTERNAL, "MatSetBlockSize");
+    if (!st) st = pk(MatPreallocatorPreallocate(pre, PETSC_TRUE, s->A), MPM_EINTERNAL, "MatPreallocatorPreallocate");
+    /* a block outside the counted structure is a bug, not a reallocation */
+    if (!st) st = pk(MatSetOption(s->A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), MPM_EINTERNAL, "MatSetOption");
+    if (pre) MatDestroy(&pre);
+    if (st) destroy_matrix(s);
+    return st;
+}
+
+/* The rigid-body modes of the owned nodes about the whole scene's centroid. */
+static int set_near_null_space_ranks(Petsc *s, const int *coord)
+{
+    if (!s->rbm) return pk(MatSetNearNullSpace(s->A, NULL), MPM_EINTERNAL, "MatSetNearNullSpace");
+    double c[4] = {0, 0, 0, 0};
+    for (int i = 0; i < s->n; ++i)
+        if (s->owned[i]) {
+            for (int d = 0; d < 3; ++d) c[d] += coord[3 * i + d];
+            c[3] += 1;
+        }
+    if (MPI_Allreduce(MPI_IN_PLACE, c, 4, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD) != MPI_SUCCESS)
+        return mpm_error(MPM_EINTERNAL, "petsc: MPI_Allreduce of the centroid failed");
+    for (int d = 0; d < 3; ++d) c[d] /= c[3] > 0 ? c[3] : 1;
+    Vec xyz = NULL;
+    MatNullSpace nsp = NULL;
+    PetscScalar *p = NULL;
+    int st = pk(VecCreateMPI(PETSC_COMM_WORLD, 3 * s->num.n_owned, PETSC_DECIDE, &xyz), MPM_EINTERNAL, "VecCreateMPI");
+    if (!st) st = pk(VecSetBlockSize(xyz, 3), MPM_EINTERNAL, "VecSetBlockSize");
+    if (!st) st = pk(VecGetArray(xyz, &p), MPM_EINTERNAL, "VecGetArray");
+    if (!st) {
+        int k = 0;
+        for (int i = 0; i < s->n; ++i)
+            if (s->owned[i]) {
+                for (int d = 0; d < 3; ++d) p[3 * k + d] = coord[3 * i + d] - c[d];
+                ++k;
+            }
+        st = pk(VecRestoreArray(xyz, &p), MPM_EINTERNAL, "VecRestoreArray");
+    }
+    if (!st) st = pk(MatNullSpaceCreateRigidBody(xyz, &nsp), MPM_EINTERNAL, "MatNullSpaceCreateRigidBody");
+    if (!st) st = pk(MatSetNearNullSpace(s->A, nsp), MPM_EINTERNAL, "MatSetNearNullSpace");
+    if (nsp) MatNullSpaceDestroy(&nsp);
+    if (xyz) VecDestroy(&xyz);
+    return st;
+}
+
+/* A full setup across ranks: numbering, structure, values, near-null
+ * space, a KSP on PETSC_COMM_WORLD. Every rank calls it (a setup is
+ * collective); a local failure before the first PETSc collective fails
+ * every rank. */
+static int setup_ranks(Petsc *s, const InvSetupInput *in)
+{
+    const Bsr *H = in->H;
+    s->dist = 1;
+    s->comm = in->comm;
+    s->owned = in->owned;
+    s->n = H->n;
+    s->coord = in->coord;
+    s->coloring = in->coloring;
+    int st = set_options(s);
+    if (!st) st = reserve_ranks(s, H);
+    if (!st && !in->coord) st = mpm_error(MPM_EINTERNAL, "petsc: needs node coordinates across ranks");
+    if ((st = comm_agree(in->comm, st))) return st;
+    if ((st = dist_node_numbering(in->comm, in->owned, H->n, s->gid, &s->num))) return st;
+    st = build_structure_ranks(s, H);
+    if (!st) st = fill_values_ranks(s, H);
+    if (!st) st = set_near_null_space_ranks(s, in->coord);
+    if (!st) st = build_solver(s, MPM_EINTERNAL);
+    return st;
+}
+
+/* r's owned entries packed (across ranks), or r itself */
+static const double *owned_part(Petsc *s, const double *r, double *packed)
+{
+    if (!s->dist) return r;
+    int k = 0;
+    for (int i = 0; i < s->n; ++i)
+        if (s->owned[i]) memcpy(packed + 3 * (size_t)k++, r + 3 * (size_t)i, 3 * sizeof(double));
+    return packed;
+}
+
+/* the packed owned entries back into z, zeros at the ghosts */
+static void unpack_owned(const Petsc *s, const double *packed, double *z)
+{
+    int k = 0;
+    for (int i = 0; i < s->n; ++i) {
+        if (s->owned[i]) memcpy(z + 3 * (size_t)i, packed + 3 * (size_t)k++, 3 * sizeof(double));
+        else memset(z + 3 * (size_t)i, 0, 3 * sizeof(double));
+    }
 }
 
 /* ---- the probe: the options set up once on a small matrix at create ---- */
@@ -481,6 +681,11 @@ static void petsc_destroy(InvApprox *self)
     free(s->r_proj);
     free(s->ia);
     free(s->ja);
+    free(s->gid);
+    free(s->row_cols);
+    free(s->row_vals);
+    free(s->r_owned);
+    free(s->z_owned);
     free(s);
 }
 
@@ -583,7 +788,8 @@ static int petsc_create(SolverOptions *opt, InvApprox **out)
     s->complete = strcmp(ksp_type, "preonly") != 0;
     /* a KSP to its tolerance is not a fixed linear map; one PCApply is
      * (symmetric for the symmetric PCs the presets use) */
-    s->base.caps = INV_NEEDS_HESSIAN | INV_POSITIVE | (s->complete ? INV_VARIABLE | INV_INNER_ITERS : INV_SYMMETRIC);
+    s->base.caps = INV_NEEDS_HESSIAN | INV_POSITIVE | INV_DISTRIBUTED |
+                   (s->complete ? INV_VARIABLE | INV_INNER_ITERS : INV_SYMMETRIC);
     if (hier) { /* as the in-house mg: an adaptive coarse CG, unless to 1e-12 (then symmetric) */
         s->base.caps = INV_NEEDS_HESSIAN | INV_POSITIVE | INV_INNER_ITERS |
                        (hopt.coarse_tol <= 1e-12 ? INV_SYMMETRIC : INV_VARIABLE);
@@ -636,6 +842,15 @@ static int petsc_setup(InvApprox *self, const InvSetupInput *in)
     if (3 * (int64_t)H->n > (int64_t)0x7fffffff || 9 * H->nnzb > (int64_t)0x7fffffff)
         return mpm_error(MPM_EINTERNAL, "petsc: Hessian too large for PETSc's 32-bit indices (%d nodes, %lld blocks)",
                          H->n, (long long)H->nnzb);
+    if (in->comm) {
+        int st = setup_ranks(s, in);
+        if (!st) st = take_projection(s, in);
+        if (st) {
+            destroy_solver(s);
+            destroy_matrix(s);
+        }
+        return st;
+    }
     if (H->n == 0) {
         destroy_matrix(s);
         s->n = 0;
@@ -662,8 +877,9 @@ static int petsc_reuse(InvApprox *self, const InvSetupInput *in, int values, int
     if (!in->H || in->H->n != s->n) return mpm_error(MPM_EINTERNAL, "petsc: reused for a different matrix");
     int st = take_projection(s, in); /* the step's pointers may have moved */
     if (st || s->n == 0 || !values) return st;
-    if (!s->ksp || !same_pattern(s, in->H)) return mpm_error(MPM_EINTERNAL, "petsc: reused without a matching setup");
-    st = fill_values(s, in->H);
+    if (!s->ksp || (!s->dist && !same_pattern(s, in->H)))
+        return mpm_error(MPM_EINTERNAL, "petsc: reused without a matching setup");
+    st = s->dist ? fill_values_ranks(s, in->H) : fill_values(s, in->H);
     if (!st) st = pk(KSPSetOperators(s->ksp, s->A, s->A), MPM_EINTERNAL, "KSPSetOperators");
     if (!st) st = pk(KSPSetUp(s->ksp), MPM_ENUMERIC, "KSPSetUp");
     if (st) {
@@ -688,8 +904,8 @@ static int petsc_apply(InvApprox *self, const double *r, double *z)
         projection_apply(s->proj, s->r_proj);
         r = s->r_proj;
     }
-    int st = pk(VecPlaceArray(s->b, r), MPM_EINTERNAL, "VecPlaceArray");
-    if (!st) st = pk(VecPlaceArray(s->x, z), MPM_EINTERNAL, "VecPlaceArray");
+    int st = pk(VecPlaceArray(s->b, owned_part(s, r, s->r_owned)), MPM_EINTERNAL, "VecPlaceArray");
+    if (!st) st = pk(VecPlaceArray(s->x, s->dist ? s->z_owned : z), MPM_EINTERNAL, "VecPlaceArray");
     if (st) return st;
     if (!s->complete) {
         PC pc = NULL;
@@ -712,6 +928,7 @@ static int petsc_apply(InvApprox *self, const double *r, double *z)
     }
     VecResetArray(s->b);
     VecResetArray(s->x);
+    if (!st && s->dist) unpack_owned(s, s->z_owned, z);
     if (!st && project) projection_apply(s->proj, z);
     return st;
 }
@@ -741,11 +958,12 @@ int petsc_matvec(InvApprox *self, const double *x, double *y)
     if (!self || self->ops != &inv_petsc_ops) return mpm_error(MPM_EINTERNAL, "petsc_matvec: not a petsc inverse approximation");
     Petsc *s = (Petsc *)self;
     if (!s->A || !s->ready) return mpm_error(MPM_EINTERNAL, "petsc_matvec: no matrix (setup not done or failed)");
-    int st = pk(VecPlaceArray(s->b, x), MPM_EINTERNAL, "VecPlaceArray");
-    if (!st) st = pk(VecPlaceArray(s->x, y), MPM_EINTERNAL, "VecPlaceArray");
+    int st = pk(VecPlaceArray(s->b, owned_part(s, x, s->r_owned)), MPM_EINTERNAL, "VecPlaceArray");
+    if (!st) st = pk(VecPlaceArray(s->x, s->dist ? s->z_owned : y), MPM_EINTERNAL, "VecPlaceArray");
     if (!st) st = pk(MatMult(s->A, s->b, s->x), MPM_EINTERNAL, "MatMult");
     VecResetArray(s->b);
     VecResetArray(s->x);
+    if (!st && s->dist) unpack_owned(s, s->z_owned, y);
     return st;
 }
 
@@ -758,7 +976,9 @@ int petsc_view_text(const InvApprox *self, char *text, size_t cap)
     FILE *f = tmpfile();
     if (!f) return mpm_error(MPM_EINTERNAL, "petsc_view_text: no temporary file");
     PetscViewer v = NULL;
-    int st = pk(PetscViewerASCIIOpenWithFILE(PETSC_COMM_SELF, f, &v), MPM_EINTERNAL, "PetscViewerASCIIOpenWithFILE");
+    /* on the KSP's communicator (collective across ranks; rank 0's file holds the text) */
+    int st = pk(PetscViewerASCIIOpenWithFILE(PetscObjectComm((PetscObject)s->ksp), f, &v), MPM_EINTERNAL,
+                "PetscViewerASCIIOpenWithFILE");
     if (!st) st = pk(KSPView(s->ksp, v), MPM_EINTERNAL, "KSPView");
     if (v) PetscViewerDestroy(&v);
     text[0] = '\0';

@@ -61,7 +61,9 @@ extern const InvApproxOps inv_petsc_ops;
 int petsc_info(const InvApprox *self, int *levels, double *op_complexity);
 
 /* y = A x with the Mat PETSc holds after the last successful setup (tests:
- * it equals the Hessian passed in). */
+ * it equals the Hessian passed in). Across ranks x and y are the rank's
+ * local node vectors (zeros at ghosts, as the solvers hold them) and the
+ * call is collective. */
 int petsc_matvec(InvApprox *self, const double *x, double *y);
 
 /* KSPView of the last setup's solver into text (at most cap bytes with the

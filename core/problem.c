@@ -492,6 +492,12 @@ static int build_pattern(StepProblem *pb, Bsr *H)
             }
         }
     }
+    /* every row holds its diagonal block, which carries the mass and I - P:
+     * over ranks an owned node only other ranks' particles reach has no
+     * block of this rank's particles (on one process a no-op) */
+    const int centre = 25 * 2 + 5 * 2 + 2;
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < n; ++i) pb->rowmask[2 * (size_t)i + (centre >> 6)] |= 1ull << (centre & 63);
     /* row pointers */
     int status = bsr_reserve(H, n, 0);
     if (status) return status;
@@ -650,7 +656,8 @@ static void finish_row(const StepProblem *pb, Bsr *H, int i)
         }
         if (pb->bc[i] != BC_FREE || pb->bc[j] != BC_FREE) project_block(pb, i, j, B);
         if (j == i) {
-            add_complement(pb, i, B);
+            /* over ranks the owner alone adds I - P: the ghosts' rows are partial sums */
+            if (!pb->comm || pb->owned[i]) add_complement(pb, i, B);
             continue;
         }
         /* offset of i seen from j (the slot table's index of -d) */
@@ -740,8 +747,6 @@ static int assemble(StepProblem *pb, Bsr *H, int fused, int projected)
 
 int problem_assemble(StepProblem *pb, Bsr *H)
 {
-    if (pb->comm)
-        return mpm_error(MPM_EINPUT, "an assembled Hessian is not distributed over ranks yet: use a matrix-free solver");
     if (!pb->tangent_stored)
         return mpm_error(MPM_EINTERNAL, "problem_assemble: no tangent stored (problem_tangent first)");
     return assemble(pb, H, 0, pb->tangent_projected);
@@ -749,11 +754,37 @@ int problem_assemble(StepProblem *pb, Bsr *H)
 
 int problem_assemble_fused(StepProblem *pb, int projected, Bsr *H)
 {
-    if (pb->comm)
-        return mpm_error(MPM_EINPUT, "an assembled Hessian is not distributed over ranks yet: use a matrix-free solver");
     pb->tangent_stored = 0; /* pb->A is not updated */
     pb->tangent_projected = projected;
     return assemble(pb, H, 1, projected);
+}
+
+void problem_assembled_product(StepProblem *pb, const Bsr *H, const double *x_in, double *y)
+{
+    bsr_spmv(H, with_ghosts(pb, x_in), y);
+    halo_sum(pb, y, 3); /* the ghosts' rows are partial sums: their owners add them */
+    zero_ghosts(pb, y, 3);
+}
+
+/* A ghost's block is the identity: an inverse of it stays finite and leaves zeros zero. */
+static void identity_at_ghosts(const StepProblem *pb, double *D)
+{
+    if (!pb->comm) return;
+    for (int i = 0; i < pb->n_nodes; ++i)
+        if (!pb->owned[i]) {
+            double *Di = D + 9 * (size_t)i;
+            memset(Di, 0, 9 * sizeof(double));
+            Di[0] = Di[4] = Di[8] = 1.0;
+        }
+}
+
+void problem_assembled_diagonal(StepProblem *pb, const Bsr *H, double *D)
+{
+    bsr_diagonal(H, D);
+    /* projected blocks sum to the projected sum (P_i is every rank's), and
+     * only the owner's row holds I - P */
+    halo_sum(pb, D, 9);
+    identity_at_ghosts(pb, D);
 }
 
 void problem_hessvec(StepProblem *pb, const double *x_in, double *y)
@@ -870,13 +901,7 @@ void problem_diagonal(StepProblem *pb, double *D)
             add_complement(pb, i, Di);
         }
     }
-    if (pb->comm) /* a ghost's block is the identity: an inverse of it stays finite and leaves zeros zero */
-        for (int i = 0; i < n; ++i)
-            if (!pb->owned[i]) {
-                double *Di = D + 9 * (size_t)i;
-                memset(Di, 0, 9 * sizeof(double));
-                Di[0] = Di[4] = Di[8] = 1.0;
-            }
+    identity_at_ghosts(pb, D);
 }
 
 void problem_mark_dirichlet(StepProblem *pb, DirichletFn fn, const void *ctx)

@@ -141,7 +141,11 @@ int problem_tangent(StepProblem *pb, int projected);
 double *problem_tangent_storage(StepProblem *pb);
 
 /* Assembles the BC-projected Hessian into H (pattern built once per step,
- * storage reused) from the tangents of problem_tangent. */
+ * storage reused) from the tangents of problem_tangent. Over ranks H is
+ * the rank's part over its local nodes: a ghost's row holds this rank's
+ * particles' share only (no I - P), an owned row lacks the other ranks'
+ * shares; the whole scene's matrix is the sum of the parts, which
+ * problem_assembled_product and problem_assembled_diagonal complete. */
 int problem_assemble(StepProblem *pb, Bsr *H);
 
 /* The same Hessian (bit for bit) with the tangent computed particle block
@@ -155,6 +159,16 @@ void problem_hessvec(StepProblem *pb, const double *x, double *y);
 
 /* Diagonal 3x3 blocks of the BC-projected Hessian (9 per node). */
 void problem_diagonal(StepProblem *pb, double *D);
+
+/* y = H x with the assembled H of problem_assemble: on one process
+ * bsr_spmv; over ranks x's ghosts from their owners, the ghost rows'
+ * partial sums added into the owners, zeros at the ghosts (as
+ * problem_hessvec). Collective over ranks. */
+void problem_assembled_product(StepProblem *pb, const Bsr *H, const double *x, double *y);
+
+/* The diagonal blocks of the assembled H (bsr_diagonal), over ranks summed
+ * at the owners, the identity at ghosts (as problem_diagonal). Collective. */
+void problem_assembled_diagonal(StepProblem *pb, const Bsr *H, double *D);
 
 /* Scaled CN residual s = sqrt(1/n sum_i |g_i|^2 / kappa_i^2) (SPEC 4). The
  * stopping rule of every solver is s < eps. */

@@ -101,6 +101,14 @@ int inv_setup(InvApprox *M, const InvSetupInput *in)
         int allowed = M->ready && M->have_key && (!first || M->reuse_across_steps) &&
                       (M->reuse_every == 0 || M->since_rebuild < M->reuse_every);
         reuse = allowed && key == M->key;
+        if (in->comm) { /* over ranks every rank reuses or none does: a setup is collective */
+            double rebuild = !reuse;
+            if (in->comm->max(in->comm->ctx, &rebuild, 1)) {
+                event_log_end_with(M->log, M->setup_event, MPM_EINTERNAL);
+                return mpm_error(MPM_EINTERNAL, "%s: the ranks could not agree on setup reuse", M->ops->name);
+            }
+            reuse = rebuild == 0.0;
+        }
         if (allowed && !reuse) M->reuse.pattern_misses++;
     }
     if (reuse) {
@@ -169,7 +177,7 @@ void inv_caps_describe(unsigned caps, char *buf, size_t len)
     } names[] = {{INV_NEEDS_HESSIAN, "needs the assembled Hessian"}, {INV_MATRIX_FREE, "works matrix-free"},
                  {INV_NEEDS_PROBLEM, "needs the step problem"},    {INV_VARIABLE, "variable"},
                  {INV_SYMMETRIC, "symmetric"},                     {INV_POSITIVE, "positive"},
-                 {INV_INNER_ITERS, "inner iterations"}};
+                 {INV_INNER_ITERS, "inner iterations"},            {INV_DISTRIBUTED, "across ranks"}};
     size_t used = 0;
     if (len) buf[0] = '\0';
     for (size_t k = 0; k < sizeof names / sizeof names[0] && used < len; ++k)

@@ -23,6 +23,7 @@
 
 #include "core/bsr.h"
 #include "core/deadline.h"
+#include "core/dist/comm_ops.h"
 #include "core/event_log.h"
 #include "core/node_order.h"
 #include "solvers/krylov/linear_op.h"
@@ -43,6 +44,13 @@ typedef struct {
      * it no inner iteration starts, an inner solve stops with its current
      * iterate */
     Deadline deadline;
+    /* A problem over MPI ranks (docs/distributed.md; NULL: one process):
+     * the nodes are the rank's local ones, owned[i] = 1 where it owns node
+     * i; vectors hold zeros at ghosts; H is the rank's part (ghost rows
+     * partial: problem_assemble), diag and op are the whole scene's. Only
+     * an INV_DISTRIBUTED implementation is set up with comm. */
+    const CommOps *comm;
+    const unsigned char *owned;
 } InvSetupInput;
 
 /* Capability flags (InvApprox.caps, set by create from the options). */
@@ -54,6 +62,7 @@ enum {
     INV_SYMMETRIC = 1u << 4,     /* apply is a symmetric map: x^T M y = y^T M x */
     INV_POSITIVE = 1u << 5,      /* r^T M r > 0 for r != 0 in the free subspace (H SPD) */
     INV_INNER_ITERS = 1u << 6,   /* apply iterates inside (counts InvStats.inner_iters) */
+    INV_DISTRIBUTED = 1u << 7,   /* set up and applied on a rank's part of a problem over ranks (InvSetupInput.comm) */
 };
 
 /* Work done since the last setup. The seconds are the wrappers' intervals

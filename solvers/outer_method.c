@@ -115,7 +115,11 @@ int solve_direction_converged(SolveCtx *c, double gTp, double E, SolveStats *st)
     return 1;
 }
 
-static void apply_assembled(const void *ctx, const double *x, double *y) { bsr_spmv((const Bsr *)ctx, x, y); }
+static void apply_assembled(const void *ctx, const double *x, double *y)
+{
+    const AssembledHessian *a = ctx;
+    problem_assembled_product(a->pb, a->H, x, y);
+}
 
 static void apply_matrix_free(const void *ctx, const double *x, double *y)
 {
@@ -127,8 +131,9 @@ static void apply_projection(const void *ctx, double *v) { problem_project((cons
 void solve_hessian_op(SolveCtx *c, const Bsr *H, LinearOp *op)
 {
     op->n_nodes = c->pb->n_nodes;
+    c->assembled = (AssembledHessian){c->pb, H};
     op->apply = H ? apply_assembled : apply_matrix_free;
-    op->ctx = H ? (const void *)H : (const void *)c->pb;
+    op->ctx = H ? (const void *)&c->assembled : (const void *)c->pb;
 }
 
 void solve_projection(SolveCtx *c, Projection *P)
@@ -146,7 +151,7 @@ static int assemble(SolveCtx *c, int projected, Bsr *H, double *diag)
     if (H && !(c->inv->caps & INV_NEEDS_PROBLEM)) status = problem_assemble_fused(c->pb, projected, H);
     else if (!(status = problem_tangent(c->pb, projected)) && H) status = problem_assemble(c->pb, H);
     if (!status) {
-        if (H) bsr_diagonal(H, diag);
+        if (H) problem_assembled_diagonal(c->pb, H, diag);
         else problem_diagonal(c->pb, diag);
     }
     return event_log_end_with(c->log, c->phase[STEP_ASSEMBLE], status);
@@ -165,6 +170,9 @@ int solve_setup_inverse(SolveCtx *c, const Bsr *H, const double *diag, const Lin
                         SolveStats *st)
 {
     StepProblem *pb = c->pb;
+    if (pb->comm && !(c->inv->caps & INV_DISTRIBUTED))
+        return mpm_error(MPM_EINPUT, "inverse approximation %s has no form across ranks yet (docs/distributed.md)",
+                         c->inv->ops->name);
     InvSetupInput in = {
         .n_nodes = pb->n_nodes,
         .H = H,
@@ -175,6 +183,8 @@ int solve_setup_inverse(SolveCtx *c, const Bsr *H, const double *diag, const Lin
         .proj = proj,
         .problem = pb,
         .deadline = c->set->deadline,
+        .comm = pb->comm,
+        .owned = pb->owned,
     };
     return inv_setup(c->inv, &in);
 }

@@ -123,6 +123,13 @@ struct OuterMethod {
     int assembled;
 };
 
+/* The operator of an assembled Hessian: its matrix and, for a distributed
+ * run's halo, the problem (problem_assembled_product). */
+typedef struct {
+    StepProblem *pb;
+    const Bsr *H;
+} AssembledHessian;
+
 struct SolveCtx {
     StepProblem *pb;
     InvApprox *inv;                /* never NULL */
@@ -139,6 +146,7 @@ struct SolveCtx {
     double best_energy, best_residual;
     double energy0; /* E at iteration 0 (the decrement rule's E_0) */
     int last_progress;
+    AssembledHessian assembled; /* what solve_hessian_op's assembled operator reads */
 };
 
 /* The stopping test at the top of iteration `it` (g = gradient at the

@@ -644,14 +644,15 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
                 "ran on %d thread%s: its times are not valid (machine_load in run.json; on a shared machine "
                 "run with fewer threads, or OMP_WAIT_POLICY=passive)\n",
                 load.others_cpu_s, load.elapsed_s, load.cores, run_threads, run_threads == 1 ? "" : "s");
+    /* the parts' statistics through the view op: the hierarchy of the last
+     * setup (HOT Fig. 8: blocks per row per level; none when every step
+     * converged at its initial guess) and the named statistics; every rank
+     * takes it (a parallel library's view is collective), rank 0 writes it */
+    InvView view;
+    solver_view(solver, cfg->quiet || secondary ? NULL : stdout, &view);
     if (ses.has_comm && (status = add_distribution(out_dir, &ses))) goto done;
     if (secondary) goto done;
     if ((status = add_machine_load(out_dir, &load))) goto done;
-    /* the parts' statistics through the view op: the hierarchy of the last
-     * setup (HOT Fig. 8: blocks per row per level; none when every step
-     * converged at its initial guess) and the named statistics */
-    InvView view;
-    solver_view(solver, cfg->quiet ? NULL : stdout, &view);
     /* the library's own view of its last setup (PETSc's KSPView): the
      * options in effect, defaults included */
     if (view.library_view[0] && (status = add_to_run_json(out_dir, "inverse_view", json_string(view.library_view))))

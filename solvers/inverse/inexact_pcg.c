@@ -35,7 +35,7 @@ static int ipcg_create(SolverOptions *opt, InvApprox **out)
     s->base.ops = &inv_inexact_pcg_ops;
     /* an adaptive inner PCG: not a fixed linear map, but r^T z > 0 (CG's
      * iterate minimises the energy over a Krylov space holding it) */
-    s->base.caps = INV_MATRIX_FREE | INV_VARIABLE | INV_POSITIVE | INV_INNER_ITERS;
+    s->base.caps = INV_MATRIX_FREE | INV_VARIABLE | INV_POSITIVE | INV_INNER_ITERS | INV_DISTRIBUTED;
     s->base.flexible = 1;
     *out = &s->base;
     return MPM_OK;

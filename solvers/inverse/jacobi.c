@@ -38,7 +38,7 @@ static int jacobi_create(int scalar, InvApprox **out)
     Jacobi *J = calloc(1, sizeof *J);
     if (!J) return mpm_error(MPM_EINTERNAL, "out of memory: jacobi");
     J->base.ops = scalar ? &inv_scalar_jacobi_ops : &inv_block_jacobi_ops;
-    J->base.caps = INV_MATRIX_FREE | INV_SYMMETRIC | INV_POSITIVE;
+    J->base.caps = INV_MATRIX_FREE | INV_SYMMETRIC | INV_POSITIVE | INV_DISTRIBUTED; /* reads diag only */
     J->scalar = scalar;
     *out = &J->base;
     return MPM_OK;

@@ -70,11 +70,7 @@ static int lbfgs_solve(OuterMethod *self, SolveCtx *c, double *dv, SolveStats *s
         st->outer_iters++;
         if (it == 0) {
             /* the Hessian and its inverse approximation, once per step, lagged at dv^0 */
-            /* over MPI ranks an inverse that needs no matrix gets none (the
-             * Hessian is not distributed yet: docs/distributed.md); on one
-             * process the assembled one, as always */
-            int matrix_free = pb->comm && !(c->inv->caps & INV_NEEDS_HESSIAN);
-            if ((status = solve_assemble(c, matrix_free ? NULL : &s->H, s->diag, st))) return status;
+            if ((status = solve_assemble(c, &s->H, s->diag, st))) return status;
             if ((status = solve_setup_inverse(c, &s->H, s->diag, &op, &proj, st))) return status;
             count = head = 0;
         }

@@ -11,7 +11,9 @@
  * scene's; at a test field dv (ghost entries set to 1e30, which must never
  * be read: the halo copy replaces them) the energy, the gradient, H x and
  * the block diagonal equal the whole scene's to 1e-12 relative (the same
- * terms added in another order), the ghosts of outgoing fields are zero
+ * terms added in another order), and so do H x and the diagonal of the
+ * rank's assembled part of the Hessian (problem_assembled_product and
+ * _diagonal: ghost rows partial, completed at the owners), the ghosts of outgoing fields are zero
  * (identity blocks for the diagonal), and the CN residual and its
  * threshold tau agree. */
 #include <math.h>
@@ -118,12 +120,27 @@ static void check_scene(const CommOps *comm, const char *scene, double scale)
     problem_diagonal(&whole.sim.pb, DD);
     double dd = owned_diff(&sim, w, D, DD, 9);
     CHECK(dd <= 1e-12, "%s rank %d: diagonals differ by %.3g", scene, comm->rank, dd);
+    /* the rank's assembled part: its product and diagonal completed over
+     * the ranks equal the whole scene's assembled ones */
+    Bsr h = {0}, HW = {0};
+    double *ya = malloc(sizeof(double) * 3 * (size_t)n), *Da = malloc(sizeof(double) * 9 * (size_t)n);
+    CHECK(problem_assemble(&sim.pb, &h) == MPM_OK && problem_assemble(&whole.sim.pb, &HW) == MPM_OK,
+          "%s rank %d: assembly: %s", scene, comm->rank, mpm_last_error());
+    problem_assembled_product(&sim.pb, &h, dv, ya);
+    problem_assembled_product(&whole.sim.pb, &HW, DV, Y);
+    double ha = owned_diff(&sim, w, ya, Y, 3);
+    CHECK(ha <= 1e-12, "%s rank %d: assembled H x differ by %.3g", scene, comm->rank, ha);
+    problem_assembled_diagonal(&sim.pb, &h, Da);
+    problem_assembled_diagonal(&whole.sim.pb, &HW, DD);
+    double da = owned_diff(&sim, w, Da, DD, 9);
+    CHECK(da <= 1e-12, "%s rank %d: assembled diagonals differ by %.3g", scene, comm->rank, da);
     int ghost_bad = 0;
     for (int i = 0; i < n; ++i) {
         if (sim.dist.owned[i]) continue;
-        for (int d = 0; d < 3; ++d) ghost_bad += g[3 * i + d] != 0.0 || y[3 * i + d] != 0.0;
-        for (int k = 0; k < 9; ++k) ghost_bad += D[9 * i + k] != (k % 4 == 0 ? 1.0 : 0.0);
+        for (int d = 0; d < 3; ++d) ghost_bad += g[3 * i + d] != 0.0 || y[3 * i + d] != 0.0 || ya[3 * i + d] != 0.0;
+        for (int k = 0; k < 9; ++k) ghost_bad += D[9 * i + k] != (k % 4 == 0 ? 1.0 : 0.0) || Da[9 * i + k] != D[9 * i + k];
     }
+    bsr_free(&h), bsr_free(&HW), free(ya), free(Da);
     CHECK(ghost_bad == 0, "%s rank %d: %d ghost entries of outgoing fields are not zero (identity)", scene, comm->rank,
           ghost_bad);
     CHECK(!sim.pb.comm_failed, "%s rank %d: a halo exchange failed", scene, comm->rank);
