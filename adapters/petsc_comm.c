@@ -25,7 +25,30 @@ typedef struct {
     size_t cap_leaf;
     double *gathered;         /* sum: every rank's values */
     size_t cap_gathered;
+    CommStats stats;
+    long root_leaves;         /* other ranks' ghosts of this rank's nodes (-1: not counted yet for this plan) */
 } PetscComm;
+
+/* an operation's bytes and time into the counts: a sum sends the ghosts'
+ * values, a copy the owned nodes' values to the ranks holding them as ghosts */
+static int counted_halo(PetscComm *c, double t0, int width, int is_sum, int st)
+{
+    const double ghosts = 8.0 * c->n_ghosts * width, roots = 8.0 * (c->root_leaves > 0 ? c->root_leaves : 0) * width;
+    c->stats.halo_ops++;
+    c->stats.halo_bytes_sent += is_sum ? ghosts : roots;
+    c->stats.halo_bytes_received += is_sum ? roots : ghosts;
+    c->stats.halo_s += MPI_Wtime() - t0;
+    return st;
+}
+
+static int counted_collective(PetscComm *c, double t0, int st)
+{
+    c->stats.collectives++;
+    c->stats.collective_s += MPI_Wtime() - t0;
+    return st;
+}
+
+static void comm_stats(void *ctx, CommStats *out) { *out = ((PetscComm *)ctx)->stats; }
 
 static int mpi_status(int code, const char *what)
 {
@@ -39,12 +62,13 @@ static int mpi_status(int code, const char *what)
 static int mpi_agree(void *ctx, int status, int *agreed)
 {
     PetscComm *c = ctx;
-    return mpi_status(MPI_Allreduce(&status, agreed, 1, MPI_INT, MPI_MAX, c->comm), "MPI_Allreduce");
+    const double t0 = MPI_Wtime();
+    return counted_collective(
+        c, t0, mpi_status(MPI_Allreduce(&status, agreed, 1, MPI_INT, MPI_MAX, c->comm), "MPI_Allreduce"));
 }
 
-static int comm_sum(void *ctx, double *values, int n)
+static int comm_sum_uncounted(PetscComm *c, double *values, int n)
 {
-    PetscComm *c = ctx;
     size_t need = (size_t)n * (size_t)c->ranks;
     if (need > c->cap_gathered) {
         double *g = realloc(c->gathered, sizeof(double) * need);
@@ -62,15 +86,24 @@ static int comm_sum(void *ctx, double *values, int n)
     return MPM_OK;
 }
 
+static int comm_sum(void *ctx, double *values, int n)
+{
+    PetscComm *c = ctx;
+    const double t0 = MPI_Wtime();
+    return counted_collective(c, t0, comm_sum_uncounted(c, values, n));
+}
+
 static int comm_max(void *ctx, double *values, int n)
 {
     PetscComm *c = ctx;
-    return mpi_status(MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_DOUBLE, MPI_MAX, c->comm), "MPI_Allreduce");
+    const double t0 = MPI_Wtime();
+    return counted_collective(
+        c, t0, mpi_status(MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_DOUBLE, MPI_MAX, c->comm), "MPI_Allreduce"));
 }
 
-static int comm_exchange(void *ctx, const int *send_counts, const uint64_t *send, int *recv_counts, uint64_t **recv)
+static int exchange_uncounted(PetscComm *c, const int *send_counts, const uint64_t *send, int *recv_counts,
+                              uint64_t **recv)
 {
-    PetscComm *c = ctx;
     const int R = c->ranks;
     *recv = NULL;
     int st = mpi_status(MPI_Alltoall((void *)send_counts, 1, MPI_INT, recv_counts, 1, MPI_INT, c->comm), "MPI_Alltoall");
@@ -104,6 +137,13 @@ static int comm_exchange(void *ctx, const int *send_counts, const uint64_t *send
     return st;
 }
 
+static int comm_exchange(void *ctx, const int *send_counts, const uint64_t *send, int *recv_counts, uint64_t **recv)
+{
+    PetscComm *c = ctx;
+    const double t0 = MPI_Wtime();
+    return counted_collective(c, t0, exchange_uncounted(c, send_counts, send, recv_counts, recv));
+}
+
 static void drop_sfs(PetscComm *c)
 {
     for (int w = 0; w <= MAX_WIDTH; ++w)
@@ -129,6 +169,7 @@ static int comm_halo_plan(void *ctx, const HaloPlan *plan, int n_nodes)
     c->n_ghosts = n;
     c->n_nodes = n_nodes;
     c->planned = 1;
+    c->root_leaves = -1;
     return MPM_OK;
 }
 
@@ -170,6 +211,15 @@ static int halo_ready(PetscComm *c, int width, PetscSF *sf)
         free(remote);
         if (st) return st;
     }
+    if (c->root_leaves < 0) { /* once per plan, collective as every halo operation */
+        const PetscInt *degree = NULL;
+        int st = petsc_status(PetscSFComputeDegreeBegin(c->sf[width], &degree), MPM_EINTERNAL, "PetscSFComputeDegree");
+        if (!st) st = petsc_status(PetscSFComputeDegreeEnd(c->sf[width], &degree), MPM_EINTERNAL, "PetscSFComputeDegree");
+        if (st) return st;
+        long leaves = 0;
+        for (PetscInt k = 0; k < (PetscInt)c->n_nodes * width; ++k) leaves += degree[k];
+        c->root_leaves = leaves / width;
+    }
     *sf = c->sf[width];
     return MPM_OK;
 }
@@ -177,6 +227,7 @@ static int halo_ready(PetscComm *c, int width, PetscSF *sf)
 static int comm_halo_sum(void *ctx, double *values, int width)
 {
     PetscComm *c = ctx;
+    const double t0 = MPI_Wtime();
     PetscSF sf;
     int st = halo_ready(c, width, &sf);
     if (st) return st;
@@ -184,12 +235,13 @@ static int comm_halo_sum(void *ctx, double *values, int width)
         memcpy(c->leaf + (size_t)j * width, values + (size_t)c->ghost_node[j] * width, sizeof(double) * width);
     st = petsc_status(PetscSFReduceBegin(sf, MPI_DOUBLE, c->leaf, values, MPI_SUM), MPM_EINTERNAL, "PetscSFReduceBegin");
     if (!st) st = petsc_status(PetscSFReduceEnd(sf, MPI_DOUBLE, c->leaf, values, MPI_SUM), MPM_EINTERNAL, "PetscSFReduceEnd");
-    return st;
+    return counted_halo(c, t0, width, 1, st);
 }
 
 static int comm_halo_copy(void *ctx, double *values, int width)
 {
     PetscComm *c = ctx;
+    const double t0 = MPI_Wtime();
     PetscSF sf;
     int st = halo_ready(c, width, &sf);
     if (st) return st;
@@ -197,7 +249,7 @@ static int comm_halo_copy(void *ctx, double *values, int width)
     if (!st) st = petsc_status(PetscSFBcastEnd(sf, MPI_DOUBLE, values, c->leaf, MPI_REPLACE), MPM_EINTERNAL, "PetscSFBcastEnd");
     for (int j = 0; !st && j < c->n_ghosts; ++j)
         memcpy(values + (size_t)c->ghost_node[j] * width, c->leaf + (size_t)j * width, sizeof(double) * width);
-    return st;
+    return counted_halo(c, t0, width, 0, st);
 }
 
 static void comm_close(void *ctx)
@@ -231,6 +283,7 @@ int petsc_comm_open(CommOps *ops)
                      .halo_plan = comm_halo_plan,
                      .halo_sum = comm_halo_sum,
                      .halo_copy = comm_halo_copy,
+                     .stats = comm_stats,
                      .close = comm_close};
     return MPM_OK;
 }

@@ -29,6 +29,19 @@ typedef struct {
     const int *owner_node; /* n_ghosts: its local node id on that rank */
 } HaloPlan;
 
+/* What a rank has communicated since its table was opened (the stats op).
+ * A halo sum sends the values at this rank's ghosts and receives the other
+ * ranks' values for its owned nodes; a halo copy the reverse (8 bytes a
+ * value, as docs/distributed.md's census counts). Times include waiting
+ * for the other ranks. */
+typedef struct {
+    long halo_ops;       /* halo sums and copies */
+    double halo_bytes_sent, halo_bytes_received;
+    double halo_s;
+    long collectives;    /* agree, sum, max, exchange */
+    double collective_s;
+} CommStats;
+
 typedef struct {
     void *ctx;
     int rank, ranks;
@@ -46,6 +59,8 @@ typedef struct {
     int (*halo_plan)(void *ctx, const HaloPlan *plan, int n_nodes);
     int (*halo_sum)(void *ctx, double *node_values, int width);
     int (*halo_copy)(void *ctx, double *node_values, int width);
+    /* the counts so far; NULL: the table counts nothing (one rank) */
+    void (*stats)(void *ctx, CommStats *out);
     void (*close)(void *ctx);
 } CommOps;
 

@@ -445,29 +445,54 @@ static void write_run_json(const char *dir, const RunConfig *cfg, const Scene *s
 
 /* A distributed run's split into run.json ("distributed": the rank count,
  * each rank's particles and owned nodes at the end, the particles each
- * sent away over the run). Collective: every rank gathers, rank 0 writes. */
-static int add_distribution(const char *out_dir, const Session *ses)
+ * sent away over the run, and what each communicated: the halo's seconds
+ * and bytes, per step too, and the collectives' seconds). Collective:
+ * every rank gathers, rank 0 writes. */
+enum { DIST_PARTICLES, DIST_NODES, DIST_MOVED, DIST_HALO_S, DIST_HALO_SENT, DIST_HALO_RECEIVED, DIST_HALO_OPS, DIST_COLL_S, DIST_FIELDS };
+static int add_distribution(const char *out_dir, const Session *ses, int steps)
 {
     const CommOps *c = &ses->comm;
     const int R = c->ranks;
-    double *v = calloc(3 * (size_t)R, sizeof(double));
+    double *v = calloc(DIST_FIELDS * (size_t)R, sizeof(double));
     if (!v) return mpm_error(MPM_EINTERNAL, "out of memory");
-    v[c->rank] = (double)ses->sim.p.n;
-    v[R + c->rank] = ses->sim.dist.n_owned;
-    v[2 * R + c->rank] = (double)ses->sim.dist.migrated;
-    int st = c->sum(c->ctx, v, 3 * R);
+    CommStats cs = {0};
+    if (c->stats) c->stats(c->ctx, &cs);
+    v[DIST_PARTICLES * R + c->rank] = (double)ses->sim.p.n;
+    v[DIST_NODES * R + c->rank] = ses->sim.dist.n_owned;
+    v[DIST_MOVED * R + c->rank] = (double)ses->sim.dist.migrated;
+    v[DIST_HALO_S * R + c->rank] = cs.halo_s;
+    v[DIST_HALO_SENT * R + c->rank] = cs.halo_bytes_sent;
+    v[DIST_HALO_RECEIVED * R + c->rank] = cs.halo_bytes_received;
+    v[DIST_HALO_OPS * R + c->rank] = (double)cs.halo_ops;
+    v[DIST_COLL_S * R + c->rank] = cs.collective_s;
+    int st = c->sum(c->ctx, v, DIST_FIELDS * R);
     if (!st && c->rank == 0) {
         json_t *d = json_object(), *parts = json_array(), *nodes = json_array(), *moved = json_array();
+        json_t *halo_s = json_array(), *sent = json_array(), *received = json_array(), *sent_step = json_array();
+        json_t *ops = json_array(), *coll_s = json_array();
         for (int r = 0; r < R; ++r) {
-            json_array_append_new(parts, json_integer((json_int_t)v[r]));
-            json_array_append_new(nodes, json_integer((json_int_t)v[R + r]));
-            json_array_append_new(moved, json_integer((json_int_t)v[2 * R + r]));
+            json_array_append_new(parts, json_integer((json_int_t)v[DIST_PARTICLES * R + r]));
+            json_array_append_new(nodes, json_integer((json_int_t)v[DIST_NODES * R + r]));
+            json_array_append_new(moved, json_integer((json_int_t)v[DIST_MOVED * R + r]));
+            json_array_append_new(halo_s, json_real(v[DIST_HALO_S * R + r]));
+            json_array_append_new(sent, json_real(v[DIST_HALO_SENT * R + r]));
+            json_array_append_new(received, json_real(v[DIST_HALO_RECEIVED * R + r]));
+            json_array_append_new(sent_step, json_real(steps > 0 ? v[DIST_HALO_SENT * R + r] / steps : 0.0));
+            json_array_append_new(ops, json_integer((json_int_t)v[DIST_HALO_OPS * R + r]));
+            json_array_append_new(coll_s, json_real(v[DIST_COLL_S * R + r]));
         }
         json_object_set_new(d, "ranks", json_integer(R));
         json_object_set_new(d, "decomposition", json_string("4x4x4 node blocks along a Morton curve, cut by particles"));
         json_object_set_new(d, "particles_per_rank", parts);
         json_object_set_new(d, "owned_nodes_per_rank", nodes);
         json_object_set_new(d, "particles_sent_per_rank", moved);
+        /* the whole run (set-up and output included) */
+        json_object_set_new(d, "halo_ops_per_rank", ops);
+        json_object_set_new(d, "halo_seconds_per_rank", halo_s);
+        json_object_set_new(d, "halo_bytes_sent_per_rank", sent);
+        json_object_set_new(d, "halo_bytes_received_per_rank", received);
+        json_object_set_new(d, "halo_bytes_sent_per_step_per_rank", sent_step);
+        json_object_set_new(d, "collective_seconds_per_rank", coll_s);
         st = add_to_run_json(out_dir, "distributed", d);
     }
     free(v);
@@ -650,7 +675,7 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
      * takes it (a parallel library's view is collective), rank 0 writes it */
     InvView view;
     solver_view(solver, cfg->quiet || secondary ? NULL : stdout, &view);
-    if (ses.has_comm && (status = add_distribution(out_dir, &ses))) goto done;
+    if (ses.has_comm && (status = add_distribution(out_dir, &ses, tot->steps))) goto done;
     if (secondary) goto done;
     if ((status = add_machine_load(out_dir, &load))) goto done;
     /* the library's own view of its last setup (PETSc's KSPView): the

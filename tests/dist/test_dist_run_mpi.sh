@@ -10,7 +10,7 @@
 # converges, the steps and particles are the one-process run's, and each
 # step's outer iterations are within 2 of it. Rank 0 alone writes the
 # folder, and run.json records the ranks and each rank's particles, which
-# add up. Options that follow one trajectory are refused with exit 2 on
+# add up, and its halo traffic (the bytes sent add up to those received). Options that follow one trajectory are refused with exit 2 on
 # every rank, and so is a solver whose inverse has no form across ranks.
 . "$(dirname "$0")/../common/shell_harness.sh"
 command -v mpirun >/dev/null || skip "mpirun not found"
@@ -36,6 +36,11 @@ dist = json.load(open(f"{b}/run.json"))["distributed"]
 assert dist["ranks"] == ranks and len(dist["particles_per_rank"]) == ranks, dist
 assert sum(dist["particles_per_rank"]) == int(ra[-1]["particles"]), dist
 assert min(dist["particles_per_rank"]) > 0, dist
+# every byte a rank sends in the halo another receives; every rank takes part in every halo operation
+sent, received = sum(dist["halo_bytes_sent_per_rank"]), sum(dist["halo_bytes_received_per_rank"])
+assert sent == received > 0, (sent, received)
+assert len(set(dist["halo_ops_per_rank"])) == 1 and dist["halo_ops_per_rank"][0] > 0, dist["halo_ops_per_rank"]
+assert all(s >= 0 for s in dist["halo_seconds_per_rank"] + dist["collective_seconds_per_rank"]), dist
 print("ok")
 PY
 }
