@@ -330,24 +330,37 @@ static int same_pattern(const Petsc *s, const Bsr *H)
 }
 
 /* The six rigid-body modes of the nodes (integer coordinates about their
- * centroid) as A's near-null space. */
+ * centroid) as A's near-null space; across ranks (s->dist) the owned
+ * nodes' modes about the whole scene's centroid. */
 static int set_near_null_space(Petsc *s, int n, const int *coord)
 {
     if (!s->rbm) return pk(MatSetNearNullSpace(s->A, NULL), MPM_EINTERNAL, "MatSetNearNullSpace");
     if (!coord) return mpm_error(MPM_EINTERNAL, "petsc: petsc_rbm=on needs node coordinates");
-    double c[3] = {0, 0, 0};
+    const unsigned char *owned = s->dist ? s->owned : NULL;
+    double c[4] = {0, 0, 0, 0}; /* coordinate sums and the node count */
     for (int i = 0; i < n; ++i)
-        for (int d = 0; d < 3; ++d) c[d] += coord[3 * i + d];
-    for (int d = 0; d < 3; ++d) c[d] /= n > 0 ? n : 1;
+        if (!owned || owned[i]) {
+            for (int d = 0; d < 3; ++d) c[d] += coord[3 * i + d];
+            c[3] += 1;
+        }
+    if (s->dist && MPI_Allreduce(MPI_IN_PLACE, c, 4, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD) != MPI_SUCCESS)
+        return mpm_error(MPM_EINTERNAL, "petsc: MPI_Allreduce of the centroid failed");
+    for (int d = 0; d < 3; ++d) c[d] /= c[3] > 0 ? c[3] : 1;
+    const int rows = s->dist ? s->num.n_owned : n;
     Vec xyz = NULL;
     MatNullSpace nsp = NULL;
     PetscScalar *p = NULL;
-    int st = pk(VecCreateSeq(PETSC_COMM_SELF, 3 * n, &xyz), MPM_EINTERNAL, "VecCreateSeq");
+    int st = s->dist ? pk(VecCreateMPI(PETSC_COMM_WORLD, 3 * rows, PETSC_DECIDE, &xyz), MPM_EINTERNAL, "VecCreateMPI")
+                     : pk(VecCreateSeq(PETSC_COMM_SELF, 3 * rows, &xyz), MPM_EINTERNAL, "VecCreateSeq");
     if (!st) st = pk(VecSetBlockSize(xyz, 3), MPM_EINTERNAL, "VecSetBlockSize");
     if (!st) st = pk(VecGetArray(xyz, &p), MPM_EINTERNAL, "VecGetArray");
     if (!st) {
+        int k = 0;
         for (int i = 0; i < n; ++i)
-            for (int d = 0; d < 3; ++d) p[3 * i + d] = coord[3 * i + d] - c[d];
+            if (!owned || owned[i]) {
+                for (int d = 0; d < 3; ++d) p[3 * k + d] = coord[3 * i + d] - c[d];
+                ++k;
+            }
         st = pk(VecRestoreArray(xyz, &p), MPM_EINTERNAL, "VecRestoreArray");
     }
     if (!st) st = pk(MatNullSpaceCreateRigidBody(xyz, &nsp), MPM_EINTERNAL, "MatNullSpaceCreateRigidBody");
@@ -503,41 +516,6 @@ static int build_structure_ranks(Petsc *s, const Bsr *H)
     return st;
 }
 
-/* The rigid-body modes of the owned nodes about the whole scene's centroid. */
-static int set_near_null_space_ranks(Petsc *s, const int *coord)
-{
-    if (!s->rbm) return pk(MatSetNearNullSpace(s->A, NULL), MPM_EINTERNAL, "MatSetNearNullSpace");
-    double c[4] = {0, 0, 0, 0};
-    for (int i = 0; i < s->n; ++i)
-        if (s->owned[i]) {
-            for (int d = 0; d < 3; ++d) c[d] += coord[3 * i + d];
-            c[3] += 1;
-        }
-    if (MPI_Allreduce(MPI_IN_PLACE, c, 4, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD) != MPI_SUCCESS)
-        return mpm_error(MPM_EINTERNAL, "petsc: MPI_Allreduce of the centroid failed");
-    for (int d = 0; d < 3; ++d) c[d] /= c[3] > 0 ? c[3] : 1;
-    Vec xyz = NULL;
-    MatNullSpace nsp = NULL;
-    PetscScalar *p = NULL;
-    int st = pk(VecCreateMPI(PETSC_COMM_WORLD, 3 * s->num.n_owned, PETSC_DECIDE, &xyz), MPM_EINTERNAL, "VecCreateMPI");
-    if (!st) st = pk(VecSetBlockSize(xyz, 3), MPM_EINTERNAL, "VecSetBlockSize");
-    if (!st) st = pk(VecGetArray(xyz, &p), MPM_EINTERNAL, "VecGetArray");
-    if (!st) {
-        int k = 0;
-        for (int i = 0; i < s->n; ++i)
-            if (s->owned[i]) {
-                for (int d = 0; d < 3; ++d) p[3 * k + d] = coord[3 * i + d] - c[d];
-                ++k;
-            }
-        st = pk(VecRestoreArray(xyz, &p), MPM_EINTERNAL, "VecRestoreArray");
-    }
-    if (!st) st = pk(MatNullSpaceCreateRigidBody(xyz, &nsp), MPM_EINTERNAL, "MatNullSpaceCreateRigidBody");
-    if (!st) st = pk(MatSetNearNullSpace(s->A, nsp), MPM_EINTERNAL, "MatSetNearNullSpace");
-    if (nsp) MatNullSpaceDestroy(&nsp);
-    if (xyz) VecDestroy(&xyz);
-    return st;
-}
-
 /* A full setup across ranks: numbering, structure, values, near-null
  * space, a KSP on PETSC_COMM_WORLD. Every rank calls it (a setup is
  * collective); a local failure before the first PETSc collective fails
@@ -558,7 +536,7 @@ static int setup_ranks(Petsc *s, const InvSetupInput *in)
     if ((st = dist_node_numbering(in->comm, in->owned, H->n, s->gid, &s->num))) return st;
     st = build_structure_ranks(s, H);
     if (!st) st = fill_values_ranks(s, H);
-    if (!st) st = set_near_null_space_ranks(s, in->coord);
+    if (!st) st = set_near_null_space(s, s->n, in->coord);
     if (!st) st = build_solver(s, MPM_EINTERNAL);
     return st;
 }
