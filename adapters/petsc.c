@@ -92,7 +92,6 @@ typedef struct {
      * Hessian (ghost rows too) through MatSetValuesBlocked with ADD_VALUES,
      * PETSc's assembly moving the off-rank blocks to their owners. */
     int dist;
-    const CommOps *comm;
     const unsigned char *owned;
     NodeNumbering num;
     int *gid; /* per local node: its global number */
@@ -524,7 +523,6 @@ static int setup_ranks(Petsc *s, const InvSetupInput *in)
 {
     const Bsr *H = in->H;
     s->dist = 1;
-    s->comm = in->comm;
     s->owned = in->owned;
     s->n = H->n;
     s->coord = in->coord;

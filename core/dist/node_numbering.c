@@ -17,25 +17,23 @@ int dist_node_numbering(const CommOps *comm, const unsigned char *owned, int n, 
         free(number);
         return st;
     }
-    {
-        counts[comm->rank] = n_owned;
-        if (comm->sum(comm->ctx, counts, comm->ranks)) st = MPM_EINTERNAL;
+    counts[comm->rank] = n_owned;
+    if (comm->sum(comm->ctx, counts, comm->ranks)) st = MPM_EINTERNAL;
+    double first = 0, total = 0;
+    for (int r = 0; r < comm->ranks && !st; ++r) {
+        if (r < comm->rank) first += counts[r];
+        total += counts[r];
     }
+    /* every rank sees the same total, so all of them stop here or none */
+    if (!st && total > 0x7fffffff) st = mpm_error(MPM_EINPUT, "node numbering: %.0f nodes overflow 32-bit numbers", total);
     if (!st) {
-        double first = 0, total = 0;
-        for (int r = 0; r < comm->ranks; ++r) {
-            if (r < comm->rank) first += counts[r];
-            total += counts[r];
-        }
-        if (total > 0x7fffffff) st = mpm_error(MPM_EINPUT, "node numbering: %.0f nodes overflow 32-bit numbers", total);
-        if (total > 0x7fffffff) total = first = 0;
         out->n_owned = n_owned;
         out->first = (int)first;
         out->total = (int)total;
         int next = out->first;
         for (int i = 0; i < n; ++i) number[i] = owned[i] ? next++ : -1.0;
         /* the ghosts from their owners (numbers below 2^53 are exact doubles) */
-        if (!st && comm->halo_copy(comm->ctx, number, 1)) st = MPM_EINTERNAL;
+        if (comm->halo_copy(comm->ctx, number, 1)) st = MPM_EINTERNAL;
         for (int i = 0; i < n && !st; ++i) {
             global[i] = (int)number[i];
             if (global[i] < 0 || global[i] >= out->total)

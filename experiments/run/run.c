@@ -446,9 +446,9 @@ static void write_run_json(const char *dir, const RunConfig *cfg, const Scene *s
 /* A distributed run's split into run.json ("distributed": the rank count,
  * each rank's particles and owned nodes at the end, the particles each
  * sent away over the run, and what each communicated: the halo's seconds
- * and bytes, per step too, and the collectives' seconds). Collective:
+ * and bytes, per step too, the collectives and their seconds). Collective:
  * every rank gathers, rank 0 writes. */
-enum { DIST_PARTICLES, DIST_NODES, DIST_MOVED, DIST_HALO_S, DIST_HALO_SENT, DIST_HALO_RECEIVED, DIST_HALO_OPS, DIST_COLL_S, DIST_FIELDS };
+enum { DIST_PARTICLES, DIST_NODES, DIST_MOVED, DIST_HALO_S, DIST_HALO_SENT, DIST_HALO_RECEIVED, DIST_HALO_OPS, DIST_COLL_OPS, DIST_COLL_S, DIST_FIELDS };
 static int add_distribution(const char *out_dir, const Session *ses, int steps)
 {
     const CommOps *c = &ses->comm;
@@ -464,12 +464,13 @@ static int add_distribution(const char *out_dir, const Session *ses, int steps)
     v[DIST_HALO_SENT * R + c->rank] = cs.halo_bytes_sent;
     v[DIST_HALO_RECEIVED * R + c->rank] = cs.halo_bytes_received;
     v[DIST_HALO_OPS * R + c->rank] = (double)cs.halo_ops;
+    v[DIST_COLL_OPS * R + c->rank] = (double)cs.collectives;
     v[DIST_COLL_S * R + c->rank] = cs.collective_s;
     int st = c->sum(c->ctx, v, DIST_FIELDS * R);
     if (!st && c->rank == 0) {
         json_t *d = json_object(), *parts = json_array(), *nodes = json_array(), *moved = json_array();
         json_t *halo_s = json_array(), *sent = json_array(), *received = json_array(), *sent_step = json_array();
-        json_t *ops = json_array(), *coll_s = json_array();
+        json_t *ops = json_array(), *coll_ops = json_array(), *coll_s = json_array();
         for (int r = 0; r < R; ++r) {
             json_array_append_new(parts, json_integer((json_int_t)v[DIST_PARTICLES * R + r]));
             json_array_append_new(nodes, json_integer((json_int_t)v[DIST_NODES * R + r]));
@@ -479,6 +480,7 @@ static int add_distribution(const char *out_dir, const Session *ses, int steps)
             json_array_append_new(received, json_real(v[DIST_HALO_RECEIVED * R + r]));
             json_array_append_new(sent_step, json_real(steps > 0 ? v[DIST_HALO_SENT * R + r] / steps : 0.0));
             json_array_append_new(ops, json_integer((json_int_t)v[DIST_HALO_OPS * R + r]));
+            json_array_append_new(coll_ops, json_integer((json_int_t)v[DIST_COLL_OPS * R + r]));
             json_array_append_new(coll_s, json_real(v[DIST_COLL_S * R + r]));
         }
         json_object_set_new(d, "ranks", json_integer(R));
@@ -492,6 +494,7 @@ static int add_distribution(const char *out_dir, const Session *ses, int steps)
         json_object_set_new(d, "halo_bytes_sent_per_rank", sent);
         json_object_set_new(d, "halo_bytes_received_per_rank", received);
         json_object_set_new(d, "halo_bytes_sent_per_step_per_rank", sent_step);
+        json_object_set_new(d, "collectives_per_rank", coll_ops);
         json_object_set_new(d, "collective_seconds_per_rank", coll_s);
         st = add_to_run_json(out_dir, "distributed", d);
     }

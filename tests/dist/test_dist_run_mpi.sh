@@ -36,10 +36,11 @@ dist = json.load(open(f"{b}/run.json"))["distributed"]
 assert dist["ranks"] == ranks and len(dist["particles_per_rank"]) == ranks, dist
 assert sum(dist["particles_per_rank"]) == int(ra[-1]["particles"]), dist
 assert min(dist["particles_per_rank"]) > 0, dist
-# every byte a rank sends in the halo another receives; every rank takes part in every halo operation
+# every byte a rank sends in the halo another receives; every rank takes part in every halo operation and collective
 sent, received = sum(dist["halo_bytes_sent_per_rank"]), sum(dist["halo_bytes_received_per_rank"])
 assert sent == received > 0, (sent, received)
 assert len(set(dist["halo_ops_per_rank"])) == 1 and dist["halo_ops_per_rank"][0] > 0, dist["halo_ops_per_rank"]
+assert len(set(dist["collectives_per_rank"])) == 1 and dist["collectives_per_rank"][0] > 0, dist["collectives_per_rank"]
 assert all(s >= 0 for s in dist["halo_seconds_per_rank"] + dist["collective_seconds_per_rank"]), dist
 print("ok")
 PY
