@@ -36,6 +36,9 @@ typedef struct {
     const CommOps *comm;
     Decomposition decomp; /* the blocks each rank owns */
     DistGrid dist;        /* this rank's owned nodes and ghosts */
+    double rebalance_above; /* > 0: a new cut when the busiest rank's particles pass this times the mean */
+    int recuts;             /* new cuts made so far (dist_rebalance) */
+    double worst_imbalance; /* the largest busiest-over-mean particle count after a step's migration */
 } Simulation;
 
 int sim_init(Simulation *sim, const Scene *scene);

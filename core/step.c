@@ -271,6 +271,7 @@ int step_end(Simulation *sim, const double *dv)
         size_t sent = 0;
         st = dist_migrate(sim, &sent);
         sim->dist.migrated += sent;
+        if (!st) st = dist_rebalance(sim);
     }
     return st;
 }

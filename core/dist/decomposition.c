@@ -26,50 +26,59 @@ uint64_t block_curve_key(const int B[3])
            spread_bits((uint64_t)(B[2] + CURVE_OFFSET));
 }
 
-int decomposition_balance(const int *base, size_t n, int ranks, Decomposition *d)
+int decomposition_particle_blocks(const int *base, size_t n, uint64_t **block_key, size_t **block_count, size_t *nb)
 {
-    d->ranks = 0;
-    d->first_key = NULL;
-    if (ranks < 1) return mpm_error(MPM_EINPUT, "ranks: must be >= 1, got %d", ranks);
-    uint64_t *key = malloc(sizeof(uint64_t) * (n ? n : 1));
+    *block_key = NULL;
+    *block_count = NULL;
+    *nb = 0;
+    uint64_t *key = calloc(n ? n : 1, sizeof(uint64_t));
     size_t *order = malloc(sizeof(size_t) * (n ? n : 1));
-    uint64_t *block_key = malloc(sizeof(uint64_t) * (n ? n : 1));
-    size_t *block_count = malloc(sizeof(size_t) * (n ? n : 1));
-    d->first_key = malloc(sizeof(uint64_t) * ((size_t)ranks + 1));
-    int status = MPM_OK;
-    if (!key || !order || !block_key || !block_count || !d->first_key) {
-        status = mpm_error(MPM_EINTERNAL, "out of memory: decomposing %zu particles", n);
-        goto done;
-    }
-    if (n == 0) {
-        status = mpm_error(MPM_EINPUT, "ranks: %d ranks but no particle to own", ranks);
-        goto done;
-    }
-    for (size_t k = 0; k < n; ++k) {
+    uint64_t *bk = malloc(sizeof(uint64_t) * (n ? n : 1));
+    size_t *bc = malloc(sizeof(size_t) * (n ? n : 1));
+    int status = key && order && bk && bc ? MPM_OK : mpm_error(MPM_EINTERNAL, "out of memory: %zu particles' blocks", n);
+    for (size_t k = 0; !status && k < n; ++k) {
         int B[3];
         node_block_of(base + 3 * k, B);
         key[k] = block_curve_key(B);
     }
-    if ((status = radix_sort_u64(n, key, order))) goto done;
-
-    /* the particle blocks along the curve with their particle counts */
-    size_t nb = 0;
-    for (size_t i = 0; i < n; ++i) {
+    if (!status) status = radix_sort_u64(n, key, order);
+    size_t m = 0;
+    for (size_t i = 0; !status && i < n; ++i) {
         uint64_t k = key[order[i]];
-        if (nb && block_key[nb - 1] == k) {
-            ++block_count[nb - 1];
+        if (m && bk[m - 1] == k) {
+            ++bc[m - 1];
         } else {
-            block_key[nb] = k;
-            block_count[nb++] = 1;
+            bk[m] = k;
+            bc[m++] = 1;
         }
     }
-    if ((size_t)ranks > nb) {
-        status = mpm_error(MPM_EINPUT, "ranks: %d ranks but only %zu node blocks hold particles (more ranks than "
-                                       "blocks: a rank would own no particle)",
-                           ranks, nb);
-        goto done;
+    free(key);
+    free(order);
+    if (status) {
+        free(bk);
+        free(bc);
+        return status;
     }
+    *block_key = bk;
+    *block_count = bc;
+    *nb = m;
+    return MPM_OK;
+}
 
+int decomposition_cut(const uint64_t *block_key, const size_t *block_count, size_t nb, int ranks, Decomposition *d)
+{
+    d->ranks = 0;
+    d->first_key = NULL;
+    if (ranks < 1) return mpm_error(MPM_EINPUT, "ranks: must be >= 1, got %d", ranks);
+    size_t n = 0;
+    for (size_t b = 0; b < nb; ++b) n += block_count[b];
+    if (n == 0) return mpm_error(MPM_EINPUT, "ranks: %d ranks but no particle to own", ranks);
+    if ((size_t)ranks > nb)
+        return mpm_error(MPM_EINPUT, "ranks: %d ranks but only %zu node blocks hold particles (more ranks than "
+                                     "blocks: a rank would own no particle)",
+                         ranks, nb);
+    d->first_key = malloc(sizeof(uint64_t) * ((size_t)ranks + 1));
+    if (!d->first_key) return mpm_error(MPM_EINTERNAL, "out of memory: decomposing %zu particles", n);
     /* Rank r starts at the first block whose middle lies past r n / ranks
      * particles along the curve: each end lands within half a block of its
      * target. Every rank keeps at least one block. */
@@ -84,12 +93,20 @@ int decomposition_balance(const int *base, size_t n, int ranks, Decomposition *d
     }
     d->first_key[ranks] = UINT64_MAX;
     d->ranks = ranks;
-done:
-    free(key);
-    free(order);
+    return MPM_OK;
+}
+
+int decomposition_balance(const int *base, size_t n, int ranks, Decomposition *d)
+{
+    d->ranks = 0;
+    d->first_key = NULL;
+    if (ranks < 1) return mpm_error(MPM_EINPUT, "ranks: must be >= 1, got %d", ranks);
+    uint64_t *block_key;
+    size_t *block_count, nb;
+    int status = decomposition_particle_blocks(base, n, &block_key, &block_count, &nb);
+    if (!status) status = decomposition_cut(block_key, block_count, nb, ranks, d);
     free(block_key);
     free(block_count);
-    if (status) decomposition_free(d);
     return status;
 }
 

@@ -45,6 +45,15 @@ static inline void node_block_of(const int c[3], int B[3])
  * blocks"); MPM_EINTERNAL when out of memory. */
 int decomposition_balance(const int *base, size_t n, int ranks, Decomposition *d);
 
+/* The two halves of decomposition_balance, for a re-cut over ranks whose
+ * particles no rank holds all of (dist_rebalance). The blocks holding the
+ * particles with base nodes `base`, in curve order, and their particle
+ * counts (malloc'd: the caller frees both). */
+int decomposition_particle_blocks(const int *base, size_t n, uint64_t **block_key, size_t **block_count, size_t *nb);
+/* The cut of blocks in increasing key order (each key once) with their
+ * particle counts; the errors of decomposition_balance. */
+int decomposition_cut(const uint64_t *block_key, const size_t *block_count, size_t nb, int ranks, Decomposition *d);
+
 /* The rank owning the block at block coordinates B. */
 int decomposition_owner(const Decomposition *d, const int B[3]);
 

@@ -164,3 +164,99 @@ int dist_migrate(Simulation *sim, size_t *sent)
     free(recv);
     return st;
 }
+
+/* Every rank's particle blocks to every rank: each rank's blocks lie in its
+ * own key interval, and the intervals follow the ranks, so the blocks come
+ * in curve order, each once (checked). */
+static int gather_blocks(const CommOps *c, const uint64_t *key, const size_t *count, size_t nb, uint64_t **all_key,
+                         size_t **all_count, size_t *n_all)
+{
+    const int R = c->ranks;
+    int *send_counts = calloc((size_t)R, sizeof(int)), *recv_counts = calloc((size_t)R, sizeof(int));
+    uint64_t *send = malloc(sizeof(uint64_t) * (2 * nb * (size_t)R + 1)), *recv = NULL;
+    int st = send_counts && recv_counts && send ? MPM_OK : mpm_error(MPM_EINTERNAL, "out of memory: %zu blocks", nb);
+    for (int r = 0; !st && r < R; ++r) {
+        send_counts[r] = (int)(2 * nb);
+        for (size_t b = 0; b < nb; ++b) {
+            send[2 * (nb * (size_t)r + b)] = key[b];
+            send[2 * (nb * (size_t)r + b) + 1] = count[b];
+        }
+    }
+    st = comm_agree(c, st);
+    if (!st) st = c->exchange(c->ctx, send_counts, send, recv_counts, &recv);
+    size_t m = 0;
+    for (int r = 0; !st && r < R; ++r) m += (size_t)recv_counts[r] / 2;
+    *all_key = st ? NULL : malloc(sizeof(uint64_t) * (m ? m : 1));
+    *all_count = st ? NULL : malloc(sizeof(size_t) * (m ? m : 1));
+    if (!st && (!*all_key || !*all_count)) st = mpm_error(MPM_EINTERNAL, "out of memory: %zu blocks", m);
+    for (size_t b = 0; !st && b < m; ++b) {
+        (*all_key)[b] = recv[2 * b];
+        (*all_count)[b] = (size_t)recv[2 * b + 1];
+        if (b && (*all_key)[b] <= (*all_key)[b - 1])
+            st = mpm_error(MPM_EINTERNAL, "rebalance: the ranks' blocks are not in curve order at block %zu", b);
+    }
+    *n_all = m;
+    free(send_counts);
+    free(recv_counts);
+    free(send);
+    free(recv);
+    return comm_agree(c, st);
+}
+
+int dist_rebalance(Simulation *sim)
+{
+    const CommOps *c = sim->comm;
+    const int R = c->ranks;
+    double *count = calloc((size_t)R, sizeof(double));
+    int st = comm_agree(c, count ? MPM_OK : mpm_error(MPM_EINTERNAL, "out of memory: %d ranks", R));
+    if (st) {
+        free(count);
+        return st;
+    }
+    count[c->rank] = (double)sim->p.n;
+    if (c->sum(c->ctx, count, R)) st = MPM_EINTERNAL;
+    double total = 0.0, most = 0.0;
+    for (int r = 0; r < R; ++r) {
+        total += count[r];
+        if (count[r] > most) most = count[r];
+    }
+    free(count);
+    const double imbalance = total > 0 ? most * R / total : 1.0;
+    if (imbalance > sim->worst_imbalance) sim->worst_imbalance = imbalance;
+    /* the same counts on every rank: all of them cut again, or none */
+    if (st || sim->rebalance_above <= 0 || imbalance <= sim->rebalance_above) return st;
+    const Particles *p = &sim->p;
+    const double dx = sim->scene->dx;
+    int *base = malloc(sizeof(int) * 3 * (p->n ? p->n : 1));
+    uint64_t *key = NULL, *all_key = NULL;
+    size_t *cnt = NULL, *all_count = NULL, nb = 0, n_all = 0;
+    st = base ? MPM_OK : mpm_error(MPM_EINTERNAL, "out of memory: %zu particles", p->n);
+    for (size_t k = 0; !st && k < 3 * p->n; ++k) base[k] = (int)floor(p->x[k] / dx - 0.5);
+    if (!st) st = decomposition_particle_blocks(base, p->n, &key, &cnt, &nb);
+    free(base);
+    st = comm_agree(c, st);
+    if (!st) st = gather_blocks(c, key, cnt, nb, &all_key, &all_count, &n_all);
+    /* fewer particle blocks than ranks: the old cut stays (every rank
+     * keeps a block of it) */
+    Decomposition cut = {0, NULL};
+    const int can_cut = n_all >= (size_t)R;
+    if (!st && can_cut) st = comm_agree(c, decomposition_cut(all_key, all_count, n_all, R, &cut));
+    free(key);
+    free(cnt);
+    free(all_key);
+    free(all_count);
+    /* block granularity may give the same cut again: nothing moves then */
+    int same = !st && can_cut;
+    for (int r = 0; same && r <= R; ++r) same = cut.first_key[r] == sim->decomp.first_key[r];
+    if (st || !can_cut || same) {
+        decomposition_free(&cut);
+        return st;
+    }
+    decomposition_free(&sim->decomp);
+    sim->decomp = cut;
+    sim->recuts++;
+    size_t sent = 0;
+    st = dist_migrate(sim, &sent);
+    sim->dist.migrated += sent;
+    return st;
+}

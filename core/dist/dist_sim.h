@@ -31,5 +31,18 @@ int dist_p2g_halo(Simulation *sim);
  * arrivals follow rank after rank. *sent (when not NULL) gets how many
  * left this rank. Collective. */
 int dist_migrate(Simulation *sim, size_t *sent);
+/* After dist_migrate: the imbalance, the busiest rank's particles over the
+ * mean, into sim->worst_imbalance; past sim->rebalance_above (> 0) the
+ * curve is cut again by the ranks' particle blocks (decomposition_cut, the
+ * same cut on every rank) and the particles migrate to their new owners
+ * (sim->recuts counts the cuts that changed; a cut equal to the old one,
+ * which block granularity can give, or fewer particle blocks than ranks
+ * leaves the old one). Collective. */
+int dist_rebalance(Simulation *sim);
+
+/* The default of rebalance_above: a rank 20 % over the mean slows every
+ * step by as much, while a cut costs an exchange of the block counts and
+ * one migration. */
+#define DIST_REBALANCE_ABOVE_DEFAULT 1.2
 
 #endif

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "core/dist/dist_sim.h"
 #include "core/error.h"
 #include "core/threads.h"
 #include "experiments/accuracy/error_ref.h"
@@ -38,6 +39,14 @@ const Option run_settings[] = {
      "grid spacing times S (particle counts scale as 1/S^3; default 1)"},
     {"--threads", "threads", "T", OPT_INT, 1, MPM_MAX_THREADS, "an integer number of threads", NULL, F(threads), 0,
      NULL, OPT_IN_DEFAULTS | OPT_AXIS | OPT_ID_ALWAYS, "OpenMP threads (default: OMP_NUM_THREADS or every core)"},
+    {"--ranks", "ranks", "R", OPT_INT, 1, RUN_MAX_RANKS, "an integer number of MPI ranks", NULL, F(ranks), 0, NULL,
+     MATRIX_ALL | OPT_AXIS | OPT_ID_GIVEN,
+     "the MPI ranks the scene is split over: the run refuses any other count (launch it as mpirun -np R mpmbench "
+     "run; in a matrix file the runner does, docs/distributed.md)"},
+    {"--rebalance-above", "rebalance_above", "X", OPT_REAL, 0, 1e9, "a ratio >= 0", NULL, F(rebalance_above), 0, NULL,
+     MATRIX_ALL | OPT_ID_GIVEN,
+     "over ranks: cut the grid again when the busiest rank holds more than X times the mean particles (default "
+     OPT_SPELLED(DIST_REBALANCE_ABOVE_DEFAULT) "; 0: never)"},
     {"--frames", "frames", "N", OPT_INT, 1, 0, NULL, NULL, F(frames), 0, NULL, MATRIX_ALL | OPT_ID_ALWAYS,
      "frames to simulate (default: the scene's)"},
     {"--set", "set", "PATH=VALUE", OPT_LIST, 0, 0, "key=value", NULL, F(set), F(n_set), session_check_override,

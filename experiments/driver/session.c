@@ -56,7 +56,13 @@ int session_open(const SessionConfig *c, Session *s)
     if (c->distributed) {
         if ((st = registry_comm_open(&s->comm))) goto fail;
         s->has_comm = 1;
+        /* every rank sees the same count: all of them stop here or none */
+        if (c->ranks > 0 && s->comm.ranks != c->ranks) {
+            st = mpm_error(MPM_EINPUT, "--ranks %d: this run is on %d MPI ranks", c->ranks, s->comm.ranks);
+            goto fail;
+        }
         if ((st = sim_distribute(&s->sim, &s->comm))) goto fail;
+        s->sim.rebalance_above = c->rebalance_above;
         vec_sum_over_ranks(&s->comm);
     }
     return MPM_OK;

@@ -33,6 +33,8 @@ typedef struct {
     int n_solver_opts;
     int threads;                    /* <= 0: OpenMP's default (OMP_NUM_THREADS or every core) */
     int distributed;                /* split the scene over the MPI ranks the program runs on (core/dist/) */
+    int ranks;                      /* > 0 and distributed: the ranks it must find */
+    double rebalance_above;         /* distributed: a new cut past this imbalance (0: never; dist_sim.h) */
 } SessionConfig;
 
 /* Not to be copied: sim points into scene. */

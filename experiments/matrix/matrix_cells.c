@@ -496,6 +496,20 @@ static int add_repeats(MatrixCells *out, int n)
     return MPM_OK;
 }
 
+/* A cell over ranks cannot do what `run` refuses over ranks
+ * (docs/distributed.md): said once, when the matrix is read, not by every
+ * cell's exit 2. */
+static int ranks_refusal(const Matrix *m, const MatrixCell *c, const MatrixReference *r)
+{
+    const char *what = r                     ? "a reference run (its trajectory)"
+                       : c->run.error_ref     ? "error_ref"
+                       : c->run.particles_dir ? "particles"
+                                              : NULL;
+    if (!what) return MPM_OK;
+    return mpm_error(MPM_EINPUT, "%s: scene \"%s\": ranks %d: not with %s yet (docs/distributed.md)", m->base,
+                     c->run.scene, c->run.ranks, what);
+}
+
 int matrix_expand(const Matrix *m, MatrixCells *out)
 {
     memset(out, 0, sizeof *out);
@@ -524,7 +538,8 @@ int matrix_expand(const Matrix *m, MatrixCells *out)
         st = build_cell(m, idx, c);
         int keep = !st && rules_keep(m, c);
         const MatrixReference *r = keep ? scene_reference(m, c->run.scene) : NULL;
-        if (r) { /* the reference first: its id is part of the cell's settings */
+        if (keep && c->run.ranks > 1) st = ranks_refusal(m, c, r);
+        if (r && !st) { /* the reference first: its id is part of the cell's settings */
             MatrixCell *rc = &refs[n_refs];
             st = build_reference(r, c, rc);
             int j = st ? -1 : find_same(refs, n_refs, rc);
@@ -594,6 +609,7 @@ void matrix_cell_describe(const Matrix *m, const MatrixCell *c, char *out, size_
     matrix_format_number(c->run.scale, scale, sizeof scale);
     size_t len = (size_t)snprintf(out, n, "eps=%s scale=%s", eps, scale);
     if (c->run.threads && len < n) len += (size_t)snprintf(out + len, n - len, " threads=%d", c->run.threads);
+    if (c->run.ranks && len < n) len += (size_t)snprintf(out + len, n - len, " ranks=%d", c->run.ranks);
     if (c->run.frames && !(c->sample_frames && !c->is_reference) && len < n)
         len += (size_t)snprintf(out + len, n - len, " frames=%d", c->run.frames);
     if (c->first_timed_frame && len < n) len += (size_t)snprintf(out + len, n - len, " timed-from=%d", c->first_timed_frame);

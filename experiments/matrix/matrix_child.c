@@ -45,15 +45,56 @@ static int open_out(const char *dir, const char *name)
     return open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
 }
 
-int cell_child_start(char *const *args, int argc, const char *dir, double timeout_s, CellChild *c)
+/* The launcher's path: the first `name` on PATH that is executable, into out. */
+static int find_on_path(const char *name, char *out, size_t cap)
+{
+    const char *path = getenv("PATH");
+    for (const char *p = path; p && *p;) {
+        size_t len = strcspn(p, ":");
+        int w = snprintf(out, cap, "%.*s/%s", (int)len, len ? p : ".", name);
+        if (w > 0 && (size_t)w < cap && access(out, X_OK) == 0) return 1;
+        p += len + (p[len] == ':');
+    }
+    return 0;
+}
+
+/* The variables a cell over ranks adds (Open MPI reads its own, others
+ * ignore them): ranks may outnumber cores and run as root, and no rank is
+ * bound to one core (a rank's threads would share it); each rank's OpenMP
+ * team is the cores over the ranks unless the cell sets --threads. */
+enum { LAUNCH_ENV = 5 };
+static void launch_env(int ranks, char text[LAUNCH_ENV][64])
+{
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    long per_rank = cores > ranks ? cores / ranks : 1;
+    snprintf(text[0], 64, "OMPI_ALLOW_RUN_AS_ROOT=1");
+    snprintf(text[1], 64, "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1");
+    snprintf(text[2], 64, "OMPI_MCA_rmaps_base_oversubscribe=1");
+    snprintf(text[3], 64, "OMPI_MCA_hwloc_base_binding_policy=none");
+    snprintf(text[4], 64, "OMP_NUM_THREADS=%ld", per_rank);
+}
+
+int cell_child_start(char *const *args, int argc, const char *dir, double timeout_s, int ranks, CellChild *c)
 {
     memset(c, 0, sizeof *c);
     /* everything the child needs is prepared before fork: after it, only
      * async-signal-safe calls until execve */
+    const int launched = ranks > 1;
+    char launcher[1024] = "/proc/self/exe", self[1024] = "", np[16] = "", added[LAUNCH_ENV][64];
+    if (launched) {
+        ssize_t len = readlink("/proc/self/exe", self, sizeof self - 1);
+        if (len <= 0 || (size_t)len >= sizeof self - 1)
+            return mpm_error(MPM_EINTERNAL, "%s: cannot find this program's path for mpirun", dir);
+        self[len] = '\0';
+        if (!find_on_path("mpirun", launcher, sizeof launcher))
+            return mpm_error(MPM_EINPUT, "%s: ranks %d: no mpirun on PATH (Debian package openmpi-bin)", dir, ranks);
+        snprintf(np, sizeof np, "%d", ranks);
+        launch_env(ranks, added);
+    }
     size_t n_env = 0;
     while (environ[n_env]) n_env++;
-    char **env = malloc(sizeof *env * (n_env + 2));
-    char **argv = malloc(sizeof *argv * (size_t)(argc + 2));
+    char **env = malloc(sizeof *env * (n_env + 2 + LAUNCH_ENV));
+    char **argv = malloc(sizeof *argv * (size_t)(argc + 5));
     int out = open_out(dir, "stdout.txt"), err = open_out(dir, "stderr.txt");
     int in = open("/dev/null", O_RDONLY | O_CLOEXEC);
     long max_fd = sysconf(_SC_OPEN_MAX);
@@ -67,12 +108,23 @@ int cell_child_start(char *const *args, int argc, const char *dir, double timeou
     if (!st) {
         size_t k = 0;
         for (size_t i = 0; i < n_env; ++i)
-            if (!matrix_is_launcher_env(environ[i]) && strncmp(environ[i], "MPM_MATRIX_CELL=", 16)) env[k++] = environ[i];
+            if (!matrix_is_launcher_env(environ[i]) && strncmp(environ[i], "MPM_MATRIX_CELL=", 16) &&
+                !(launched && !strncmp(environ[i], "OMP_NUM_THREADS=", 16)))
+                env[k++] = environ[i];
         env[k++] = "MPM_MATRIX_CELL=1"; /* run leaves the machine's load to the runner (cells.csv) */
+        for (int i = 0; launched && i < LAUNCH_ENV; ++i) env[k++] = added[i];
         env[k] = NULL;
-        argv[0] = "mpmbench";
-        for (int i = 0; i < argc; ++i) argv[i + 1] = args[i];
-        argv[argc + 1] = NULL;
+        int a = 0;
+        if (launched) {
+            argv[a++] = "mpirun";
+            argv[a++] = "-np";
+            argv[a++] = np;
+            argv[a++] = self;
+        } else {
+            argv[a++] = "mpmbench";
+        }
+        for (int i = 0; i < argc; ++i) argv[a++] = args[i];
+        argv[a] = NULL;
         pid = fork();
         if (pid < 0) st = mpm_error(MPM_EINTERNAL, "fork failed starting a cell in %s", dir);
     }
@@ -90,7 +142,7 @@ int cell_child_start(char *const *args, int argc, const char *dir, double timeou
         dup2(out, 1);
         dup2(err, 2);
         for (long fd = 3; fd < max_fd; ++fd) close((int)fd);
-        execve("/proc/self/exe", argv, env);
+        execve(launcher, argv, env);
         _exit(127);
     }
     if (pid > 0) {
@@ -98,6 +150,7 @@ int cell_child_start(char *const *args, int argc, const char *dir, double timeou
         c->pid = pid;
         c->t_start = event_clock();
         c->timeout_s = timeout_s;
+        c->ranks = ranks;
         c->busy0 = busy0;
         c->load0 = load0;
     }
@@ -139,7 +192,11 @@ int cell_child_poll(CellChild *c, CellOutcome *out)
                  1e-6 * (double)ru.ru_stime.tv_usec;
     /* the machine's busy time is counted in clock ticks (10 ms): a tick or so
      * of difference is no load */
-    if (busy1 >= 0 && c->busy0 >= 0) {
+    /* a killed mpirun never reaped its ranks: their CPU time is not in
+     * cpu_s, so the others' time is unknown */
+    const int ranks_lost = c->timed_out && c->ranks > 1;
+    out->others_cpu_s = -1.0;
+    if (busy1 >= 0 && c->busy0 >= 0 && !ranks_lost) {
         out->others_cpu_s = busy1 - c->busy0 - out->cpu_s;
         if (out->others_cpu_s < 0) out->others_cpu_s = 0.0;
     }

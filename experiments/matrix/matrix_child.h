@@ -22,13 +22,17 @@ typedef struct {
     double t_start;     /* monotonic seconds */
     double timeout_s;   /* 0: none */
     int timed_out;
+    int ranks;          /* > 1: under mpirun */
     double busy0;       /* machine_busy_seconds() at the start */
     double load0;       /* machine_load1() at the start */
 } CellChild;
 
 /* Starts `mpmbench args[0] ... args[argc-1]` with its output files in dir
- * (which must exist). */
-int cell_child_start(char *const *args, int argc, const char *dir, double timeout_s, CellChild *c);
+ * (which must exist); with ranks > 1 under `mpirun -np ranks` (the first
+ * mpirun on PATH; Open MPI's variables let ranks outnumber cores and run
+ * as root, bind no rank to a core, and OMP_NUM_THREADS is the cores over
+ * the ranks). */
+int cell_child_start(char *const *args, int argc, const char *dir, double timeout_s, int ranks, CellChild *c);
 /* Never blocks: 0 while the child runs, 1 when it ended (reaped) with *out
  * set (with the machine's other CPU use meanwhile: others_cpu_s, load_start;
  * `busy` is for the caller, who knows the cell's threads). Past the timeout

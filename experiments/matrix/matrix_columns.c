@@ -12,6 +12,7 @@ const MatrixColumnInfo matrix_columns[MATRIX_COLS] = {
     [MATRIX_COL_EPS] = {"eps", MATRIX_COL_ALWAYS},
     [MATRIX_COL_SCALE] = {"scale", MATRIX_COL_ALWAYS},
     [MATRIX_COL_THREADS] = {"threads", MATRIX_COL_ALWAYS},
+    [MATRIX_COL_RANKS] = {"ranks", MATRIX_COL_WITH_RANKS},
     [MATRIX_COL_FRAMES_ASKED] = {"frames_asked", MATRIX_COL_ALWAYS},
     [MATRIX_COL_FIRST_TIMED_FRAME] = {"first_timed_frame", MATRIX_COL_ALWAYS},
     [MATRIX_COL_ERROR_REF] = {"error_ref", MATRIX_COL_WITH_ERROR_REF},

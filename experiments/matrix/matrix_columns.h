@@ -14,7 +14,8 @@ typedef enum {
     MATRIX_COL_SOLVER,
     MATRIX_COL_EPS,
     MATRIX_COL_SCALE,
-    MATRIX_COL_THREADS,           /* the run's own count when the matrix left it to OpenMP */
+    MATRIX_COL_THREADS,           /* the run's own count when the matrix left it to OpenMP (per rank) */
+    MATRIX_COL_RANKS,             /* the MPI ranks the scene was split over */
     MATRIX_COL_FRAMES_ASKED,      /* the run's own count when the matrix left it to the scene */
     MATRIX_COL_FIRST_TIMED_FRAME,
     MATRIX_COL_ERROR_REF,
@@ -34,7 +35,8 @@ typedef enum {
     MATRIX_COL_WITH_ERROR_REF,  /* error_ref is given somewhere */
     MATRIX_COL_WITH_REPEAT,     /* repeat > 1 */
     MATRIX_COL_WITH_REFERENCES, /* some cell has a reference run */
-    MATRIX_COL_WITH_SAMPLES     /* some reference run has sample_frames */
+    MATRIX_COL_WITH_SAMPLES,    /* some reference run has sample_frames */
+    MATRIX_COL_WITH_RANKS       /* ranks is given somewhere */
 } MatrixColumnWhen;
 
 typedef struct {

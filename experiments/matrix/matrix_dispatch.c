@@ -42,6 +42,7 @@ static void write_command(const MatrixTask *t, char *const *args)
     snprintf(path, sizeof path, "%s/cmd.txt", t->dir);
     FILE *f = fopen(path, "w");
     if (!f) return;
+    if (t->ranks > 1) fprintf(f, "mpirun -np %d ", t->ranks);
     fputs("mpmbench", f);
     for (int i = 0; i < t->argc; ++i) {
         int plain = args[i][0] != '\0';
@@ -77,7 +78,7 @@ static int slot_start(Slot *s, const MatrixTask *t)
     if (!st) st = paths_mkdir_p(t->dir);
     if (st) return st;
     write_command(&s->task, args);
-    if ((st = cell_child_start(args, t->argc, t->dir, t->timeout_s, &s->child))) return st;
+    if ((st = cell_child_start(args, t->argc, t->dir, t->timeout_s, t->ranks, &s->child))) return st;
     s->busy = 1;
     return MPM_OK;
 }
@@ -93,7 +94,9 @@ static int slot_poll(Slot *s, int rank, MatrixResult *r)
     cell_measure(s->task.dir, s->task.first_timed_frame, &r->measure);
     if (r->outcome.status == CELL_OK && r->measure.cut_short) r->outcome.status = CELL_TIME_LIMIT;
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    r->outcome.busy = machine_was_busy(r->outcome.others_cpu_s, r->outcome.elapsed_s, r->measure.threads_run, (int)cores);
+    /* a cell over ranks on this machine uses every rank's threads */
+    const int threads = r->measure.threads_run * (s->task.ranks > 1 ? s->task.ranks : 1);
+    r->outcome.busy = machine_was_busy(r->outcome.others_cpu_s, r->outcome.elapsed_s, threads, (int)cores);
     s->busy = 0;
     return 1;
 }

@@ -25,6 +25,7 @@
 typedef struct {
     int index;                 /* the caller's cell index */
     int first_timed_frame;
+    int ranks;                 /* > 1: the cell runs under mpirun -np ranks */
     double timeout_s;          /* 0: none */
     int after;                 /* position in the task list of the task this one waits for; -1: none */
     char dir[1024];            /* the cell directory (wiped and recreated) */

@@ -630,10 +630,13 @@ static int get_top(Matrix *m)
     m->has_references = m->reference.has;
     m->has_samples = m->reference.has && m->reference.sample_frames;
     int ke = run_setting_index("error_ref");
+    int kr = run_setting_index("ranks");
     m->uses_error_ref = (m->defaults.given >> ke & 1) || m->axis[ke].n > 0;
+    m->uses_ranks = (m->defaults.given >> kr & 1) || m->axis[kr].n > 0;
     for (int i = 0; i < m->n_per_scene; ++i) {
         const MatrixSettings *ps = &m->per_scene[i].s;
         m->uses_error_ref |= ps->given >> ke & 1;
+        m->uses_ranks |= ps->given >> kr & 1;
         m->has_references |= ps->has_reference && ps->reference.has;
         m->has_samples |= ps->has_reference && ps->reference.has && ps->reference.sample_frames;
     }

@@ -111,6 +111,7 @@ typedef struct {
     int has_references;           /* some scene has a reference run */
     int has_samples;              /* some reference run has sample_frames */
     int uses_error_ref;           /* error_ref given anywhere: a cells.csv column */
+    int uses_ranks;               /* ranks given anywhere: a cells.csv column */
     json_t *root;                 /* the parsed file */
     char **pool;                  /* the texts the settings point to */
     int n_pool, cap_pool;

@@ -53,6 +53,8 @@ int matrix_results_has(const Matrix *m, MatrixColumn k)
         return m->has_references;
     case MATRIX_COL_WITH_SAMPLES:
         return m->has_samples;
+    case MATRIX_COL_WITH_RANKS:
+        return m->uses_ranks;
     case MATRIX_COL_ALWAYS:
         break;
     }
@@ -107,6 +109,9 @@ void matrix_results_field(const MatrixCell *c, const CellMeasure *x, MatrixColum
         break;
     case MATRIX_COL_THREADS:
         snprintf(out, cap, "%d", threads);
+        break;
+    case MATRIX_COL_RANKS:
+        snprintf(out, cap, "%d", c->run.ranks > 0 ? c->run.ranks : 1);
         break;
     case MATRIX_COL_FRAMES_ASKED:
         snprintf(out, cap, "%d", frames);

@@ -266,6 +266,7 @@ static int build_tasks(Run *r, MatrixTask **out)
         }
         t[n].index = r->todo[k];
         t[n].first_timed_frame = c->first_timed_frame;
+        t[n].ranks = c->run.ranks;
         t[n].timeout_s = c->timeout_s;
         int w = snprintf(t[n].dir, sizeof t[n].dir, "%s/cells/%s", r->dir, c->id);
         int st = w < 0 || (size_t)w >= sizeof t[k].dir ? mpm_error(MPM_EINPUT, "%s: output path too long", r->dir) : MPM_OK;

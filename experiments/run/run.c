@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "core/dist/dist_sim.h"
 #include "core/error.h"
 #include "core/event_log.h"
 #include "core/step.h"
@@ -36,6 +37,7 @@ void run_config_default(RunConfig *c)
     c->eps = SOLVE_EPS_DEFAULT;
     c->scale = 1.0;
     c->vtk_grid_min_mass = VTK_GRID_MIN_MASS_DEFAULT;
+    c->rebalance_above = DIST_REBALANCE_ABOVE_DEFAULT;
 }
 
 void run_solve_settings(const RunConfig *cfg, SolveSettings *set)
@@ -60,7 +62,8 @@ void run_session_config(const RunConfig *cfg, SessionConfig *sc, const char **li
     int n = solver_option_list(cfg, list);
     *sc = (SessionConfig){.scene = cfg->scene, .scale = cfg->scale, .set = cfg->set, .n_set = cfg->n_set,
                           .asset_dir = cfg->asset_dir, .max_particles = cfg->max_particles, .solver = cfg->solver,
-                          .solver_opts = list, .n_solver_opts = n, .threads = cfg->threads};
+                          .solver_opts = list, .n_solver_opts = n, .threads = cfg->threads, .ranks = cfg->ranks,
+                          .rebalance_above = cfg->rebalance_above};
 }
 
 /* Frame numbers >= 0 separated by commas (increasing when asked): the
@@ -349,9 +352,36 @@ static int write_step(void *ctx, const Simulation *sim, int frame, int step, con
     return MPM_OK;
 }
 
+/* --vtk-grid: is there a grid to write, and its heaviest node (the whole
+ * scene's over ranks: collective). */
+static int vtk_grid_frame(const RunOutput *o, const Simulation *sim, VtkGridFrame *grid, int *with_grid)
+{
+    *grid = (VtkGridFrame){&sim->grid, sim->vnew, o->comm ? sim->dist.owned : NULL, 0.0};
+    *with_grid = o->vtk && o->vtk->grid && sim->vnew && (o->comm || sim->grid.n > 0);
+    if (*with_grid) grid->heaviest = vtk_heaviest_node(&sim->grid, grid->owned);
+    if (o->comm && o->vtk && o->vtk->grid && o->comm->max(o->comm->ctx, &grid->heaviest, 1)) return MPM_EINTERNAL;
+    return MPM_OK;
+}
+
+static int write_frame_files(RunOutput *o, const Simulation *sim, const FrameSums *fs, int stopping,
+                             const VtkGridFrame *grid);
+
+/* Over ranks the frame's collectives come first and an agreement last: a
+ * rank that failed to write stops every rank before the next step's
+ * collectives. */
 static int write_frame(void *ctx, const Simulation *sim, const FrameSums *fs, int stopping)
 {
     RunOutput *o = ctx;
+    VtkGridFrame grid;
+    int with_grid = 0;
+    int status = vtk_grid_frame(o, sim, &grid, &with_grid);
+    if (!status) status = write_frame_files(o, sim, fs, stopping, with_grid ? &grid : NULL);
+    return o->comm ? comm_agree(o->comm, status) : status;
+}
+
+static int write_frame_files(RunOutput *o, const Simulation *sim, const FrameSums *fs, int stopping,
+                             const VtkGridFrame *grid)
+{
     FILE *f = o->frames_csv;
     /* complete 0: the run's time limit cut the frame short (not a frame to time) */
     csv_write_name(f, o->scene->name);
@@ -377,7 +407,7 @@ static int write_frame(void *ctx, const Simulation *sim, const FrameSums *fs, in
     }
     if (o->vtk && !stopping)
         return vtk_series_frame(o->vtk, fs->frame + 1, sim->t, &sim->p, o->scene->materials, o->scene->n_materials,
-                                &sim->grid, sim->vnew);
+                                grid);
     return MPM_OK;
 }
 
@@ -488,6 +518,10 @@ static int add_distribution(const char *out_dir, const Session *ses, int steps)
         json_object_set_new(d, "particles_per_rank", parts);
         json_object_set_new(d, "owned_nodes_per_rank", nodes);
         json_object_set_new(d, "particles_sent_per_rank", moved);
+        /* the same on every rank: the counts they cut by were summed */
+        json_object_set_new(d, "rebalance_above", json_real(ses->sim.rebalance_above));
+        json_object_set_new(d, "recuts", json_integer(ses->sim.recuts));
+        json_object_set_new(d, "worst_imbalance", json_real(ses->sim.worst_imbalance));
         /* the whole run (set-up and output included) */
         json_object_set_new(d, "halo_ops_per_rank", ops);
         json_object_set_new(d, "halo_seconds_per_rank", halo_s);
@@ -514,8 +548,7 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     /* under mpirun the scene is split over the ranks (docs/distributed.md) */
     scfg.distributed = under_mpi_launcher();
     if (scfg.distributed) {
-        const char *other = cfg->vtk_dir         ? "--vtk"
-                            : cfg->particles_dir  ? "--particles"
+        const char *other = cfg->particles_dir    ? "--particles"
                             : cfg->trajectory     ? "--trajectory"
                             : cfg->trajectory_ref ? "--trajectory-ref"
                             : cfg->dt_from        ? "--dt-from"
@@ -525,6 +558,9 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
                             : cfg->sample_frames  ? "--sample-frames"
                                                   : NULL;
         if (other) return mpm_error(MPM_EINPUT, "%s: not in a run over MPI ranks yet (docs/distributed.md)", other);
+    } else if (cfg->ranks > 1) {
+        return mpm_error(MPM_EINPUT, "--ranks %d: this run is one process; launch it as mpirun -np %d mpmbench run ...",
+                         cfg->ranks, cfg->ranks);
     }
     SolveSettings set;
     run_solve_settings(cfg, &set);
@@ -597,17 +633,19 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     FILE *steps_csv = NULL, *frames_csv = NULL, *iters_csv = NULL;
     VtkSeries vtk;
     memset(&vtk, 0, sizeof vtk);
-    if (!secondary && (status = paths_mkdir_p(out_dir))) goto done;
-    if (cfg->particles_dir && (status = paths_mkdir_p(cfg->particles_dir))) goto done;
-    if (cfg->vtk_dir && (status = vtk_series_open(&vtk, cfg->vtk_dir, cfg->vtk_grid, cfg->vtk_grid_min_mass))) goto done;
-    if (!(steps_csv = open_in(out_dir, "steps.csv", &status))) goto done;
-    if (!(frames_csv = open_in(out_dir, "frames.csv", &status))) goto done;
-    if (cfg->history && !(iters_csv = open_in(out_dir, "iters.csv", &status))) goto done;
-    if ((status = run_accuracy_open(&acc, out_dir, scene))) goto done;
+    if (!secondary && (status = paths_mkdir_p(out_dir))) goto setup_end;
+    if (cfg->particles_dir && (status = paths_mkdir_p(cfg->particles_dir))) goto setup_end;
+    if (cfg->vtk_dir && (status = vtk_series_open(&vtk, cfg->vtk_dir, cfg->vtk_grid, cfg->vtk_grid_min_mass,
+                                                  ses.has_comm ? ses.comm.rank : 0, ses.has_comm ? ses.comm.ranks : 1)))
+        goto setup_end;
+    if (!(steps_csv = open_in(out_dir, "steps.csv", &status))) goto setup_end;
+    if (!(frames_csv = open_in(out_dir, "frames.csv", &status))) goto setup_end;
+    if (cfg->history && !(iters_csv = open_in(out_dir, "iters.csv", &status))) goto setup_end;
+    if ((status = run_accuracy_open(&acc, out_dir, scene))) goto setup_end;
     if (!secondary)
         write_run_json(out_dir, cfg, scene, solver, &set, &acc, frames, n_samples ? samples[0] : sim->frame, threads,
                        &status);
-    if (status) goto done;
+    if (status) goto setup_end;
     fprintf(steps_csv, "scene,solver,frame,step,t,dt,particles,active_nodes,hessian_blocks,outer_iters,linear_iters,"
                        "ls_evals,residual,status,wall_s,p2g_s,assemble_s,setup_s,solve_s,linesearch_s,g2p_s,threads,"
                        "inner_iters,max_energy_rise,%s,reason\n",
@@ -619,8 +657,13 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     if (iters_csv) fprintf(iters_csv, "frame,step,iter,elapsed_s,residual,energy\n");
 
     if (cfg->vtk_dir && (status = vtk_series_frame(&vtk, sim->frame, sim->t, &sim->p, scene->materials, scene->n_materials,
-                                                   NULL, NULL)))
-        goto done;
+                                                   NULL)))
+        goto setup_end;
+setup_end:
+    /* over ranks a rank that could not make its files stops every rank
+     * here, before the first step's collectives */
+    if (ses.has_comm) status = comm_agree(&ses.comm, status);
+    if (status) goto done;
     sum->particles = scene->particles.n;
     sum->threads = threads;
     if (!cfg->quiet) {

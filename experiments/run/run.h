@@ -13,6 +13,7 @@
 #include "solvers/solver.h"
 
 #define RUN_MAX_LIST 64          /* --set and --solver-opt values */
+#define RUN_MAX_RANKS 65536      /* --ranks: a bound on typing errors, not on the decomposition */
 #define RUN_SET_TEXT SESSION_SET_TEXT /* characters of one --set key=value, with its NUL */
 
 /* The settings of a run. Every field but the lists is set by one line of the
@@ -26,6 +27,8 @@ typedef struct {
     double eps;                 /* CN tolerance (default SOLVE_EPS_DEFAULT, solvers/solver.h) */
     double scale;               /* dx multiplier */
     int threads;                /* <= 0: OpenMP default */
+    int ranks;                  /* > 0: the MPI ranks the run must find itself on (a matrix cell runs under mpirun -np ranks) */
+    double rebalance_above;     /* over ranks: cut the grid again past this imbalance (0: never) */
     const char *out_dir;        /* NULL: out/<scene>-<solver> */
     const char *set[RUN_MAX_LIST]; /* --set PATH=VALUE texts, in order (a later one wins) */
     int n_set;

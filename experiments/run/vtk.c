@@ -10,14 +10,16 @@
 #include "core/fcr.h"
 #include "experiments/io/paths.h"
 
-int vtk_series_open(VtkSeries *s, const char *dir, int grid, double min_mass)
+int vtk_series_open(VtkSeries *s, const char *dir, int grid, double min_mass, int rank, int ranks)
 {
     memset(s, 0, sizeof *s);
     if (snprintf(s->dir, sizeof s->dir, "%s", dir) >= (int)sizeof s->dir)
         return mpm_error(MPM_EINPUT, "--vtk '%s': path too long", dir);
     s->grid = grid;
     s->min_mass = min_mass;
-    return paths_mkdir_p(dir);
+    s->rank = rank;
+    s->ranks = ranks > 1 ? ranks : 1;
+    return paths_mkdir_p(dir); /* on every rank: no rank waits for another to make it */
 }
 
 void vtk_series_free(VtkSeries *s)
@@ -123,8 +125,51 @@ static int write_vtp(const char *path, size_t n, const float *points, const VtkA
     return MPM_OK;
 }
 
-/* DIR/NAME.pvd listing NAME_NNNN.vtp of the given frames and times (rewritten whole). */
-static int write_pvd(const char *dir, const char *name, const int *frame, const double *t, int n)
+/* The file of a frame: NAME_NNNN.vtp on one process; over ranks each rank's
+ * piece NAME_NNNN_rK.vtp and rank 0's NAME_NNNN.pvtp that lists them. */
+static void frame_path(const VtkSeries *s, const char *name, int frame, char *out, size_t cap)
+{
+    if (s->ranks > 1) snprintf(out, cap, "%s/%s_%04d_r%d.vtp", s->dir, name, frame, s->rank);
+    else snprintf(out, cap, "%s/%s_%04d.vtp", s->dir, name, frame);
+}
+
+/* DIR/NAME_NNNN.pvtp: the ranks' pieces of a frame and their arrays' types
+ * (ParaView reads them as one data set). */
+static int write_pvtp(const VtkSeries *s, const char *name, int frame, const VtkArray *data, int n_data)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s_%04d.pvtp", s->dir, name, frame);
+    FILE *f = fopen(path, "w");
+    if (!f) return mpm_error(MPM_EINPUT, "%s: cannot write", path);
+    fprintf(f, "<?xml version=\"1.0\"?>\n<VTKFile type=\"PPolyData\" version=\"1.0\" byte_order=\"%s\" "
+               "header_type=\"UInt64\">\n  <PPolyData GhostLevel=\"0\">\n    <PPointData>\n",
+            host_little_endian() ? "LittleEndian" : "BigEndian");
+    for (int i = 0; i < n_data; ++i)
+        fprintf(f, "      <PDataArray type=\"%s\" Name=\"%s\" NumberOfComponents=\"%d\"/>\n", data[i].type,
+                data[i].name, data[i].components);
+    fprintf(f, "    </PPointData>\n    <PPoints>\n      <PDataArray type=\"Float32\" Name=\"Points\" "
+               "NumberOfComponents=\"3\"/>\n    </PPoints>\n");
+    for (int r = 0; r < s->ranks; ++r) fprintf(f, "    <Piece Source=\"%s_%04d_r%d.vtp\"/>\n", name, frame, r);
+    fprintf(f, "  </PPolyData>\n</VTKFile>\n");
+    int bad = ferror(f);
+    if (fclose(f) != 0 || bad) return mpm_error(MPM_EINPUT, "%s: write failed", path);
+    return MPM_OK;
+}
+
+/* A frame's file(s) of n points: this rank's piece, and over ranks rank 0's .pvtp. */
+static int write_frame_files(const VtkSeries *s, const char *name, int frame, size_t n, const float *points,
+                             const VtkArray *data, int n_data)
+{
+    char path[1200];
+    frame_path(s, name, frame, path, sizeof path);
+    int st = write_vtp(path, n, points, data, n_data);
+    if (!st && s->ranks > 1 && s->rank == 0) st = write_pvtp(s, name, frame, data, n_data);
+    return st;
+}
+
+/* DIR/NAME.pvd listing NAME_NNNN.vtp (over ranks NAME_NNNN.pvtp) of the
+ * given frames and times (rewritten whole). */
+static int write_pvd(const char *dir, const char *name, const char *ext, const int *frame, const double *t, int n)
 {
     char path[1200], tmp[1300];
     snprintf(path, sizeof path, "%s/%s.pvd", dir, name);
@@ -135,8 +180,8 @@ static int write_pvd(const char *dir, const char *name, const int *frame, const 
                "  <Collection>\n",
             host_little_endian() ? "LittleEndian" : "BigEndian");
     for (int i = 0; i < n; ++i)
-        fprintf(f, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" file=\"%s_%04d.vtp\"/>\n", t[i], name,
-                frame[i]);
+        fprintf(f, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" file=\"%s_%04d.%s\"/>\n", t[i], name,
+                frame[i], ext);
     fprintf(f, "  </Collection>\n</VTKFile>\n");
     int bad = ferror(f);
     if (fclose(f) != 0 || bad || rename(tmp, path) != 0) return mpm_error(MPM_EINPUT, "%s: write failed", path);
@@ -198,27 +243,26 @@ static int particles_file(VtkSeries *s, int frame, const Particles *p, const Mat
                        {"von_mises", "Float32", 1, vm, sizeof(float) * n},
                        {"mass", "Float32", 1, m, sizeof(float) * n},
                        {"volume", "Float32", 1, vol, sizeof(float) * n}};
-    char path[1200];
-    snprintf(path, sizeof path, "%s/particles_%04d.vtp", s->dir, frame);
-    int st = write_vtp(path, n, x, data, (int)(sizeof data / sizeof data[0]));
+    int st = write_frame_files(s, "particles", frame, n, x, data, (int)(sizeof data / sizeof data[0]));
     free(buf);
     free(mat);
     free(id);
     return st;
 }
 
-static int grid_file(VtkSeries *s, int frame, const Grid *g, const double *grid_v)
+/* The frame's heaviest node is the whole scene's (over ranks the caller
+ * gives it); a rank writes the nodes it owns (owned NULL: all). */
+static int grid_file(VtkSeries *s, int frame, const Grid *g, const double *grid_v, const unsigned char *owned,
+                     double heaviest)
 {
     size_t n = (size_t)g->n;
     float *buf = malloc(sizeof *buf * (10 * n + 1));
     if (!buf) return mpm_error(MPM_EINTERNAL, "out of memory (%zu grid nodes)", n);
     float *x = buf, *v = buf + 3 * n, *m = buf + 6 * n, *q = buf + 7 * n;
-    double heaviest = 0.0;
-    for (size_t k = 0; k < n; ++k)
-        if (g->mass[k] > heaviest) heaviest = g->mass[k];
     double floor_mass = s->min_mass * heaviest;
     size_t kept = 0;
     for (size_t k = 0; k < n; ++k) {
+        if (owned && !owned[k]) continue;
         if (s->min_mass > 0 && g->mass[k] < floor_mass) continue;
         for (int d = 0; d < 3; ++d) {
             x[3 * kept + d] = (float)(g->coord[3 * k + d] * g->dx);
@@ -231,22 +275,29 @@ static int grid_file(VtkSeries *s, int frame, const Grid *g, const double *grid_
     VtkArray data[] = {{"mass", "Float32", 1, m, sizeof(float) * n},
                        {"velocity", "Float32", 3, v, sizeof(float) * 3 * n},
                        {"momentum", "Float32", 3, q, sizeof(float) * 3 * n}};
-    char path[1200];
-    snprintf(path, sizeof path, "%s/grid_%04d.vtp", s->dir, frame);
-    int st = write_vtp(path, n, x, data, (int)(sizeof data / sizeof data[0]));
+    int st = write_frame_files(s, "grid", frame, n, x, data, (int)(sizeof data / sizeof data[0]));
     free(buf);
     return st;
 }
 
-int vtk_series_frame(VtkSeries *s, int frame, double t, const Particles *p, const Material *materials, int n_materials,
-                     const Grid *g, const double *grid_v)
+double vtk_heaviest_node(const Grid *g, const unsigned char *owned)
 {
+    double heaviest = 0.0;
+    for (int k = 0; k < g->n; ++k)
+        if ((!owned || owned[k]) && g->mass[k] > heaviest) heaviest = g->mass[k];
+    return heaviest;
+}
+
+int vtk_series_frame(VtkSeries *s, int frame, double t, const Particles *p, const Material *materials, int n_materials,
+                     const VtkGridFrame *grid)
+{
+    const char *ext = s->ranks > 1 ? "pvtp" : "vtp";
     int st = particles_file(s, frame, p, materials, n_materials);
     if (!st) st = remember(&s->t, &s->frame, &s->n, &s->cap, frame, t);
-    if (!st) st = write_pvd(s->dir, "particles", s->frame, s->t, s->n);
-    if (st || !s->grid || !g || !grid_v || g->n <= 0) return st;
-    st = grid_file(s, frame, g, grid_v);
+    if (!st && s->rank == 0) st = write_pvd(s->dir, "particles", ext, s->frame, s->t, s->n);
+    if (st || !s->grid || !grid) return st;
+    st = grid_file(s, frame, grid->g, grid->v, grid->owned, grid->heaviest);
     if (!st) st = remember(&s->grid_t, &s->grid_frame, &s->n_grid, &s->cap_grid, frame, t);
-    if (!st) st = write_pvd(s->dir, "grid", s->grid_frame, s->grid_t, s->n_grid);
+    if (!st && s->rank == 0) st = write_pvd(s->dir, "grid", ext, s->grid_frame, s->grid_t, s->n_grid);
     return st;
 }

@@ -19,7 +19,12 @@
  *
  * Every point is also a vertex cell, so ParaView draws the points as they
  * are. The .pvd is rewritten after every frame: a run that stops leaves a
- * valid series of the frames it wrote. */
+ * valid series of the frames it wrote.
+ *
+ * Over MPI ranks (docs/distributed.md) each rank writes its own particles
+ * and owned grid nodes as a piece, NAME_NNNN_rK.vtp, and rank 0 writes
+ * NAME_NNNN.pvtp, which lists the pieces, and the .pvd, which lists the
+ * .pvtp files: ParaView opens the .pvd as on one process. */
 #ifndef MPM_VTK_H
 #define MPM_VTK_H
 
@@ -40,6 +45,7 @@
 
 typedef struct {
     char dir[1024];
+    int rank, ranks;        /* over ranks: this rank's piece; rank 0 writes the lists */
     int grid;               /* also the grid series */
     double min_mass;        /* nodes lighter than min_mass x the frame's heaviest are left out */
     double *t;              /* simulated time of each written particle frame */
@@ -50,12 +56,27 @@ typedef struct {
     int n_grid, cap_grid;
 } VtkSeries;
 
-/* Makes DIR (and its parents). min_mass: the grid files leave out the nodes
- * lighter than min_mass times the frame's heaviest node (0: none). */
-int vtk_series_open(VtkSeries *s, const char *dir, int grid, double min_mass);
-/* Writes frame `frame` at time t; g / grid_v (3 per node) may be NULL (no grid file then). */
+/* A frame's grid: its nodes and velocities (3 per node), the nodes this
+ * rank owns (NULL: all) and the whole scene's heaviest node
+ * (vtk_heaviest_node, maximised over the ranks by the caller). */
+typedef struct {
+    const Grid *g;
+    const double *v;
+    const unsigned char *owned;
+    double heaviest;
+} VtkGridFrame;
+
+/* Makes DIR (and its parents; on every rank). min_mass: the grid files
+ * leave out the nodes lighter than min_mass times the frame's heaviest node
+ * (0: none). rank of ranks: this process's piece (1 rank: no pieces).
+ * Writes nothing the other ranks wait for: a caller over ranks agrees on
+ * the status. */
+int vtk_series_open(VtkSeries *s, const char *dir, int grid, double min_mass, int rank, int ranks);
+/* Writes frame `frame` at time t; grid NULL: no grid file. */
 int vtk_series_frame(VtkSeries *s, int frame, double t, const Particles *p, const Material *materials, int n_materials,
-                     const Grid *g, const double *grid_v);
+                     const VtkGridFrame *grid);
+/* The heaviest of the nodes (of the owned ones when owned is not NULL). */
+double vtk_heaviest_node(const Grid *g, const unsigned char *owned);
 void vtk_series_free(VtkSeries *s);
 
 /* The von Mises stress of the Cauchy stress of fixed-corotated elasticity at F. */

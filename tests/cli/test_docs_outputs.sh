@@ -22,7 +22,7 @@ done
 
 cat >"$tmp/m.json" <<'JSON'
 {"name": "docs-outputs",
- "defaults": {"scene": "drop", "frames": 1, "threads": 1, "scale": 2},
+ "defaults": {"scene": "drop", "frames": 1, "threads": 1, "ranks": 1, "scale": 2},
  "axes": {"scene": ["drop", "stretched-box"], "solver": ["hot"], "error_ref": ["pn-pcg:1e-9"],
           "sets": {"stiff": [{"materials.soft.E": 1e5}]}},
  "scenes": {"stretched-box": {"scale": 4, "reference": {"solver": "pn-pcg", "eps": 1e-7, "sample_frames": "0"}}},

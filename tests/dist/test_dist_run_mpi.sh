@@ -10,8 +10,12 @@
 # converges, the steps and particles are the one-process run's, and each
 # step's outer iterations are within 2 of it. Rank 0 alone writes the
 # folder, and run.json records the ranks and each rank's particles, which
-# add up, and its halo traffic (the bytes sent add up to those received). Options that follow one trajectory are refused with exit 2 on
-# every rank, and so is a solver whose inverse has no form across ranks.
+# add up, and its halo traffic (the bytes sent add up to those received).
+# --vtk writes a piece per rank and a .pvtp per frame that VTK's parallel
+# reader reads as the one-process run's particles and grid nodes. Re-cuts
+# past --rebalance-above keep drop balanced without changing its steps. Options
+# that follow one trajectory are refused with exit 2 on every rank, and so
+# is a solver whose inverse has no form across ranks.
 . "$(dirname "$0")/../common/shell_harness.sh"
 command -v mpirun >/dev/null || skip "mpirun not found"
 R=(run --scene bar3 --scale 4 --frames 2 --threads 1 --quiet)
@@ -59,9 +63,112 @@ for solver in pn-pcg-mf lbfgs:jacobi pn-pcg pn-gamg-pcg; do
     check "$solver on $ranks ranks: the one-process rows ($(tail -1 "$tmp/cmp"))" grep -qx ok "$tmp/cmp"
   done
 done
-mpirun_ranks -np 2 "$bin" "${R[@]}" --solver pn-pcg-mf --vtk "$tmp/vtk" --out "$tmp/bad" >"$tmp/out" 2>&1
+# --vtk over ranks: each rank's piece, rank 0's .pvtp and .pvd; read with
+# VTK's parallel reader they hold the one-process run's particles (by id)
+# and grid nodes (owned ones: no node twice)
+"$bin" "${R[@]}" --solver pn-pcg --vtk "$tmp/vtk1" --vtk-grid --vtk-grid-min-mass 0 --out "$tmp/v1" >"$tmp/out" 2>&1
 rc=$?
-check "--vtk over ranks: exit 2 ($rc), refused on every rank" test $rc -eq 2 -a "$(grep -c '^mpmbench: error: --vtk: not in a run over MPI ranks yet' "$tmp/out")" -eq 2
+check "--vtk on one process: exit 0 ($(head -c 300 "$tmp/out"))" test $rc -eq 0
+mpirun_ranks -np 3 "$bin" "${R[@]}" --solver pn-pcg --vtk "$tmp/vtk3" --vtk-grid --vtk-grid-min-mass 0 --out "$tmp/v3" >"$tmp/out" 2>&1
+rc=$?
+check "--vtk on 3 ranks: exit 0 ($(head -c 300 "$tmp/out"))" test $rc -eq 0
+if /usr/bin/python3 -c "import vtk" 2>/dev/null; then
+  /usr/bin/python3 - "$tmp/vtk1" "$tmp/vtk3" 3 >"$tmp/cmp" 2>&1 <<'PY'
+import sys, numpy as np, vtk
+import xml.etree.ElementTree as ET
+from vtk.util.numpy_support import vtk_to_numpy
+a, b, ranks = sys.argv[1], sys.argv[2], int(sys.argv[3])
+def read(path):
+    r = vtk.vtkXMLPPolyDataReader() if path.endswith(".pvtp") else vtk.vtkXMLPolyDataReader()
+    r.SetFileName(path); r.Update(); out = r.GetOutput(); pd = out.GetPointData()
+    arr = {pd.GetArrayName(i): vtk_to_numpy(pd.GetArray(i)) for i in range(pd.GetNumberOfArrays())}
+    return out, vtk_to_numpy(out.GetPoints().GetData()), arr
+for name in ("particles", "grid"):
+    fa = [d.get("file") for d in ET.parse(f"{a}/{name}.pvd").getroot().findall("./Collection/DataSet")]
+    fb = [d.get("file") for d in ET.parse(f"{b}/{name}.pvd").getroot().findall("./Collection/DataSet")]
+    assert fb == [f.replace(".vtp", ".pvtp") for f in fa] and fa, (fa, fb)
+    for f, g in zip(fa, fb):
+        pieces = ET.parse(f"{b}/{g}").getroot().findall("./PPolyData/Piece")
+        assert [p.get("Source") for p in pieces] == [g.replace(".pvtp", f"_r{r}.vtp") for r in range(ranks)], g
+        oa, xa, aa = read(f"{a}/{f}")
+        ob, xb, ab = read(f"{b}/{g}")
+        assert ob.GetNumberOfPoints() == oa.GetNumberOfPoints() > 0 and ob.GetNumberOfVerts() == oa.GetNumberOfVerts(), (g, ob.GetNumberOfPoints(), oa.GetNumberOfPoints())
+        assert sorted(aa) == sorted(ab), (sorted(aa), sorted(ab))
+        if name == "particles":  # the same particles, in another order; pn-pcg's steps are the one-process ones
+            ia, ib = np.argsort(aa["id"]), np.argsort(ab["id"])
+            assert np.array_equal(aa["id"][ia], ab["id"][ib]), g
+            d = np.abs(xa[ia] - xb[ib]).max()
+            assert d <= 1e-6, (g, "position", d)
+            assert np.array_equal(aa["material"][ia], ab["material"][ib]), g
+        else:  # the same nodes, each once; masses to float32 rounding
+            ka = {tuple(p): i for i, p in enumerate(xa.tolist())}
+            kb = [ka.get(tuple(p), -1) for p in xb.tolist()]
+            assert -1 not in kb and len(set(kb)) == len(kb), (g, "nodes")
+            m = aa["mass"][kb]
+            assert np.allclose(ab["mass"], m, rtol=1e-5, atol=1e-7 * m.max()), (g, "mass")
+print("ok")
+PY
+  check "--vtk over 3 ranks: the one-process particles and grid nodes ($(tail -1 "$tmp/cmp"))" grep -qx ok "$tmp/cmp"
+fi
+mpirun_ranks -np 2 "$bin" "${R[@]}" --solver pn-pcg-mf --particles "$tmp/ply" --out "$tmp/bad" >"$tmp/out" 2>&1
+rc=$?
+check "--particles over ranks: exit 2 ($rc), refused on every rank" test $rc -eq 2 -a "$(grep -c '^mpmbench: error: --particles: not in a run over MPI ranks yet' "$tmp/out")" -eq 2
+# re-cutting: drop (12 frames) falls out of its first cut; without re-cuts
+# one rank holds over 1.5x the mean (2.13 here) and one ends empty; with a
+# re-cut past 1.0001x (every changed cut) the worst stays under 1.3x, some
+# cuts are made, and the steps are the one-process ones: outer iterations
+# and particles equal, time steps to 1e-12 (drop's contact makes the PCG
+# counts differ by rounding, with or without re-cuts), and the last frame's
+# particles (--vtk, by id) are the one-process run's to 5e-5 m (measured:
+# 1.4e-5 m at most over the frames on 3 ranks with or without re-cuts, from
+# the contact at frame 7 on; exact before it)
+D=(run --scene drop --frames 12 --threads 1 --quiet --solver pn-pcg)
+"$bin" "${D[@]}" --vtk "$tmp/dvtk1" --out "$tmp/d1" >"$tmp/out" 2>&1
+rc=$?
+check "drop on one process: exit 0 ($(head -c 300 "$tmp/out"))" test $rc -eq 0
+for rb in 0 1.0001; do
+  mpirun_ranks -np 3 "$bin" "${D[@]}" --rebalance-above $rb --vtk "$tmp/dvtk-$rb" --out "$tmp/d-$rb" >"$tmp/out" 2>&1
+  rc=$?
+  check "drop on 3 ranks, --rebalance-above $rb: exit 0 ($(head -c 300 "$tmp/out"))" test $rc -eq 0
+done
+/usr/bin/python3 - "$tmp" <<'PY' >"$tmp/cmp" 2>&1
+import csv, json, sys
+tmp = sys.argv[1]
+off = json.load(open(f"{tmp}/d-0/run.json"))["distributed"]
+on = json.load(open(f"{tmp}/d-1.0001/run.json"))["distributed"]
+assert off["recuts"] == 0 and off["worst_imbalance"] > 1.5, off
+assert on["recuts"] > 0 and 1.0 <= on["worst_imbalance"] < 1.3, on
+a = list(csv.DictReader(open(f"{tmp}/d1/steps.csv")))
+b = list(csv.DictReader(open(f"{tmp}/d-1.0001/steps.csv")))
+assert len(a) == len(b) > 0, (len(a), len(b))
+for x, y in zip(a, b):
+    for k in ("frame", "step", "particles", "outer_iters", "status"):
+        assert x[k] == y[k], (x["frame"], x["step"], k, x[k], y[k])
+    assert abs(float(x["dt"]) - float(y["dt"])) <= 1e-12 * float(x["dt"]), (x["dt"], y["dt"])
+assert sum(on["particles_per_rank"]) == int(a[-1]["particles"]), on
+try:
+    import vtk, numpy as np
+    from vtk.util.numpy_support import vtk_to_numpy
+except ImportError:
+    print("ok"); sys.exit(0)
+def read(path, parallel):
+    r = vtk.vtkXMLPPolyDataReader() if parallel else vtk.vtkXMLPolyDataReader()
+    r.SetFileName(path); r.Update(); out = r.GetOutput()
+    return vtk_to_numpy(out.GetPoints().GetData()), vtk_to_numpy(out.GetPointData().GetArray("id"))
+xa, ia = read(f"{tmp}/dvtk1/particles_0012.vtp", False)
+xb, ib = read(f"{tmp}/dvtk-1.0001/particles_0012.pvtp", True)
+oa, ob = np.argsort(ia), np.argsort(ib)
+assert np.array_equal(ia[oa], ib[ob]), "ids"
+d = np.abs(xa[oa] - xb[ob]).max()
+assert d <= 5e-5, d
+print("ok")
+PY
+check "re-cuts: made, balanced, the one-process steps and particles ($(tail -1 "$tmp/cmp"))" grep -qx ok "$tmp/cmp"
+# an error on one rank only: rank 0 alone makes the output folder; the
+# others must stop with it, not wait in the first step (a hang was 124)
+mpirun_ranks -np 2 "$bin" "${R[@]}" --solver pn-pcg --out /proc/mpmbench-none/x >"$tmp/out" 2>&1
+rc=$?
+check "rank 0 cannot make its folder: exit 2 on every rank, no hang ($rc: $(head -c 200 "$tmp/out"))" test $rc -eq 2 -a "$(grep -c '^mpmbench: error: /proc/mpmbench-none: cannot create directory' "$tmp/out")" -eq 1 -a "$(grep -c '^mpmbench: error: another rank failed' "$tmp/out")" -eq 1
 mpirun_ranks -np 2 "$bin" "${R[@]}" --solver pn-sgs-pcg --out "$tmp/asm" >"$tmp/out" 2>&1
 rc=$?
 check "a solver without a form across ranks: exit 2 ($rc), one line per rank" test $rc -eq 2 -a "$(grep -c '^mpmbench: error: .*has no form across ranks' "$tmp/out")" -eq 2
