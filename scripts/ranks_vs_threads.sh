@@ -25,7 +25,9 @@ csv=$out/ranks-vs-threads.csv
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 echo "scene,scale,solver,ranks,threads,repeat,particles,steps,outer_iters,linear_iters,wall_s,halo_s_max,collective_s_max,halo_sent_per_step_max,machine_busy,build" >"$csv"
-version=$("$build/mpmbench" --version | sed 's/.*git \([0-9a-f]\{7\}\).*/\1/')
+# the build's commit, marked when its tree had uncommitted changes (then the
+# number is not that commit's)
+version=$("$build/mpmbench" --version | sed 's/.*git \([0-9a-f]\{7\}\)[0-9a-f]*\(, modified\)\{0,1\}.*/\1\2/; s/, modified/+modified/')
 for rep in $(seq 1 "$repeats"); do
   for case in bar3:1 bar3:2; do
     scene=${case%:*} scale=${case#*:}

@@ -21,7 +21,9 @@ csv=$out/rebalance.csv
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 echo "scene,scale,solver,ranks,threads,rebalance_above,repeat,particles,frames,steps,outer_iters,linear_iters,wall_s,recuts,worst_imbalance,end_imbalance,particles_sent,machine_busy,build" >"$csv"
-version=$("$build/mpmbench" --version | sed 's/.*git \([0-9a-f]\{7\}\).*/\1/')
+# the build's commit, marked when its tree had uncommitted changes (then the
+# number is not that commit's)
+version=$("$build/mpmbench" --version | sed 's/.*git \([0-9a-f]\{7\}\)[0-9a-f]*\(, modified\)\{0,1\}.*/\1\2/; s/, modified/+modified/')
 scene=drop scale=0.5 solver=pn-pcg
 for rep in $(seq 1 "$repeats"); do
   for above in 0 1.2 1.05; do
