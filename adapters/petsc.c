@@ -101,6 +101,10 @@ typedef struct {
     int64_t cap_row;
     double *r_owned, *z_owned; /* the owned nodes' entries, packed */
     int64_t cap_owned;
+    /* petsc_hierarchy across ranks: the owned nodes' coordinates, packed, and the split */
+    int *owned_coord;
+    const CommOps *comm;
+    const Decomposition *decomp;
 } Petsc;
 
 /* ---- start-up, errors ---- */
@@ -382,8 +386,12 @@ static int build_solver(Petsc *s, int status)
     /* a zero guess: apply is M r, not a correction of z's old contents */
     if (!st) st = pk(KSPSetInitialGuessNonzero(s->ksp, PETSC_FALSE), MPM_EINTERNAL, "KSPSetInitialGuessNonzero");
     PC pc = NULL;
-    if (!st && s->hier && !(st = pk(KSPGetPC(s->ksp, &pc), MPM_EINTERNAL, "KSPGetPC")))
-        st = petsc_hierarchy_attach(s->hier, pc, s->n, s->coord, s->coloring);
+    if (!st && s->hier && !(st = pk(KSPGetPC(s->ksp, &pc), MPM_EINTERNAL, "KSPGetPC"))) {
+        /* across ranks: the levels of the owned nodes, split by the run's decomposition */
+        const PetscHierarchyRanks ranks = {s->comm, s->decomp, s->num.first, s->num.total};
+        st = s->dist ? petsc_hierarchy_attach(s->hier, pc, s->num.n_owned, s->owned_coord, NULL, &ranks)
+                     : petsc_hierarchy_attach(s->hier, pc, s->n, s->coord, s->coloring, NULL);
+    }
     if (!st) st = pk(KSPSetFromOptions(s->ksp), status, "KSPSetFromOptions");
     if (!st && s->hier) st = petsc_hierarchy_configure(s->hier, pc);
     if (!st) st = pk(KSPSetUp(s->ksp), status == MPM_EINPUT ? MPM_EINPUT : MPM_ENUMERIC, "KSPSetUp");
@@ -446,6 +454,9 @@ static int reserve_ranks(Petsc *s, const Bsr *H)
         double *z = r ? realloc(s->z_owned, sizeof(double) * 3 * (size_t)H->n) : NULL;
         if (!z) return mpm_error(MPM_EINTERNAL, "out of memory: petsc owned vectors (%d nodes)", H->n);
         s->z_owned = z;
+        int *c = s->hier ? realloc(s->owned_coord, sizeof(int) * 3 * (size_t)H->n) : s->owned_coord;
+        if (s->hier && !c) return mpm_error(MPM_EINTERNAL, "out of memory: petsc owned nodes (%d nodes)", H->n);
+        s->owned_coord = c;
         s->cap_owned = 3 * (int64_t)H->n;
     }
     return MPM_OK;
@@ -532,6 +543,10 @@ static int setup_ranks(Petsc *s, const InvSetupInput *in)
     if (!st && !in->coord) st = mpm_error(MPM_EINTERNAL, "petsc: needs node coordinates across ranks");
     if ((st = comm_agree(in->comm, st))) return st;
     if ((st = dist_node_numbering(in->comm, in->owned, H->n, s->gid, &s->num))) return st;
+    s->comm = in->comm;
+    s->decomp = in->decomp;
+    for (int i = 0, k = 0; s->hier && i < H->n; ++i) /* sorted by node_order_key, as the local nodes are */
+        if (in->owned[i]) memcpy(s->owned_coord + 3 * (size_t)k++, in->coord + 3 * (size_t)i, 3 * sizeof(int));
     st = build_structure_ranks(s, H);
     if (!st) st = fill_values_ranks(s, H);
     if (!st) st = set_near_null_space(s, s->n, in->coord);
@@ -662,6 +677,7 @@ static void petsc_destroy(InvApprox *self)
     free(s->row_vals);
     free(s->r_owned);
     free(s->z_owned);
+    free(s->owned_coord);
     free(s);
 }
 
@@ -767,7 +783,7 @@ static int petsc_create(SolverOptions *opt, InvApprox **out)
     s->base.caps = INV_NEEDS_HESSIAN | INV_POSITIVE | INV_DISTRIBUTED |
                    (s->complete ? INV_VARIABLE | INV_INNER_ITERS : INV_SYMMETRIC);
     if (hier) { /* as the in-house mg: an adaptive coarse CG, unless to 1e-12 (then symmetric) */
-        s->base.caps = INV_NEEDS_HESSIAN | INV_POSITIVE | INV_INNER_ITERS |
+        s->base.caps = INV_NEEDS_HESSIAN | INV_POSITIVE | INV_INNER_ITERS | INV_DISTRIBUTED |
                        (hopt.coarse_tol <= 1e-12 ? INV_SYMMETRIC : INV_VARIABLE);
         s->base.flexible = hopt.max_levels > 1 && solver_opt_int(opt, "flexible", 1, 0, 1, &st);
     }
@@ -886,7 +902,7 @@ static int petsc_apply(InvApprox *self, const double *r, double *z)
     if (!s->complete) {
         PC pc = NULL;
         st = pk(KSPGetPC(s->ksp, &pc), MPM_EINTERNAL, "KSPGetPC");
-        if (!st && s->hier) st = petsc_hierarchy_prepare(s->hier, r);
+        if (!st && s->hier) st = petsc_hierarchy_prepare(s->hier, s->dist ? s->r_owned : r);
         if (!st) st = pk(PCApply(pc, s->b, s->x), MPM_ENUMERIC, "PCApply");
         if (!st && s->hier) st = petsc_hierarchy_finish(s->hier, &self->stats.inner_iters);
     } else {

@@ -43,9 +43,26 @@ struct PetscHierarchy {
     double *bbar[2];                   /* the input restricted straight down */
     int cap_bbar;
     long vcycles, coarse_iters, coarse_capped;
+    /* across ranks (attach's `ranks`; comm NULL: one process) */
+    const CommOps *comm;
+    MgCoarseRanks C[MG_MAX_LEVELS];    /* C[k]: level k+1's owned nodes and T[k]'s coarse numbers */
+    int n_global[MG_MAX_LEVELS], first[MG_MAX_LEVELS];
+    Mat P[MG_MAX_LEVELS];              /* the interpolations, kept for prepare's restriction */
+    Vec down[MG_MAX_LEVELS];           /* the input restricted to level l (down[0]: b's array placed) */
 };
 
 static int pk(PetscErrorCode code, int status, const char *what) { return petsc_status(code, status, what); }
+
+/* the parallel objects of the last attach across ranks */
+static void release_ranks(PetscHierarchy *h)
+{
+    for (int l = 0; l < MG_MAX_LEVELS; ++l) {
+        if (h->P[l]) MatDestroy(&h->P[l]);
+        if (h->down[l]) VecDestroy(&h->down[l]);
+        h->P[l] = NULL;
+        h->down[l] = NULL;
+    }
+}
 
 int petsc_hierarchy_create(const PetscHierarchyOptions *options, PetscHierarchy **out)
 {
@@ -70,7 +87,9 @@ void petsc_hierarchy_destroy(PetscHierarchy *h)
         free(L->dinv);
         free(L->work);
         mg_transfer_free(&h->T[l]);
+        mg_coarse_ranks_free(&h->C[l]);
     }
+    release_ranks(h);
     free(h->bbar[0]);
     free(h->bbar[1]);
     free(h);
@@ -150,8 +169,12 @@ static PetscErrorCode shell_setup(PC pc)
 {
     ShellLevel *L = NULL;
     Mat M = NULL;
+    PetscBool parallel = PETSC_FALSE;
     PetscErrorCode ierr = PCShellGetContext(pc, &L);
     if (!ierr) ierr = PCGetOperators(pc, &M, NULL);
+    if (!ierr) ierr = PetscObjectTypeCompare((PetscObject)M, MATMPIAIJ, &parallel);
+    /* across ranks: this rank's rows and columns only (the local diagonal block) */
+    if (!ierr && parallel) ierr = MatMPIAIJGetSeqAIJ(M, &M, NULL, NULL);
     if (ierr) return ierr;
     int st = bsr_from_aij(M, &L->A);
     if (!st && L->A.n != L->n)
@@ -227,25 +250,102 @@ static int interpolation_matrix(const MgTransfer *T, Mat *P)
     return st;
 }
 
-int petsc_hierarchy_attach(PetscHierarchy *h, PC pc, int n, const int *coord, const NodeColoring *coloring)
+/* P of transfer T across ranks: rows of this rank's fine nodes (global
+ * numbers first_fine + i), columns the coarse nodes' global numbers (C),
+ * preallocated exactly: an entry's column is in the diagonal part when this
+ * rank owns the coarse node. */
+static int interpolation_matrix_ranks(const MgTransfer *T, const MgCoarseRanks *C, int first_fine, int n_fine_global,
+                                      Mat *P)
 {
-    if (!coord) return mpm_error(MPM_EINTERNAL, "petsc hierarchy: needs the node coordinates");
-    h->vcycles = h->coarse_iters = h->coarse_capped = 0;
-    /* the levels as solvers/mg/mg.c builds them */
-    h->n[0] = n;
-    h->lev[0].n = n;
-    h->lev[0].coord = coord;
-    int nl = 1, st = MPM_OK;
+    const PetscInt rows = 3 * (PetscInt)T->n_fine;
+    PetscInt *dnnz = calloc((size_t)rows + 1, sizeof(PetscInt)), *onnz = calloc((size_t)rows + 1, sizeof(PetscInt));
+    int st = dnnz && onnz ? MPM_OK : mpm_error(MPM_EINTERNAL, "out of memory: petsc interpolation");
+    for (int i = 0; i < T->n_fine && !st; ++i)
+        for (int64_t k = T->p_ptr[i]; k < T->p_ptr[i + 1]; ++k) {
+            const int g = C->global[T->p_col[k]], own = g >= C->first && g < C->first + C->n_owned;
+            for (int a = 0; a < 3; ++a) (own ? dnnz : onnz)[3 * i + a]++;
+        }
+    if (!st) st = pk(MatCreate(PETSC_COMM_WORLD, P), MPM_EINTERNAL, "MatCreate");
+    if (!st)
+        st = pk(MatSetSizes(*P, rows, 3 * (PetscInt)C->n_owned, 3 * (PetscInt)n_fine_global, 3 * (PetscInt)C->total),
+                MPM_EINTERNAL, "MatSetSizes");
+    if (!st) st = pk(MatSetType(*P, MATAIJ), MPM_EINTERNAL, "MatSetType");
+    if (!st) st = pk(MatSetBlockSizes(*P, 3, 3), MPM_EINTERNAL, "MatSetBlockSizes");
+    if (!st) st = pk(MatXAIJSetPreallocation(*P, 1, dnnz, onnz, NULL, NULL), MPM_EINTERNAL, "MatXAIJSetPreallocation");
+    for (int i = 0; i < T->n_fine && !st; ++i)
+        for (int a = 0; a < 3 && !st; ++a) {
+            const PetscInt row = 3 * (PetscInt)(first_fine + i) + a;
+            for (int64_t k = T->p_ptr[i]; k < T->p_ptr[i + 1] && !st; ++k) {
+                const PetscInt col = 3 * (PetscInt)C->global[T->p_col[k]] + a;
+                const PetscScalar w = T->p_w[k];
+                st = pk(MatSetValues(*P, 1, &row, 1, &col, &w, INSERT_VALUES), MPM_EINTERNAL, "MatSetValues");
+            }
+        }
+    if (!st) st = pk(MatAssemblyBegin(*P, MAT_FINAL_ASSEMBLY), MPM_EINTERNAL, "MatAssemblyBegin");
+    if (!st) st = pk(MatAssemblyEnd(*P, MAT_FINAL_ASSEMBLY), MPM_EINTERNAL, "MatAssemblyEnd");
+    free(dnnz);
+    free(onnz);
+    return st;
+}
+
+/* The levels as solvers/mg/mg.c builds them, on one process: level k+1 is
+ * the coarse set of level k's nodes, until max_levels or too few nodes. */
+static int build_levels(PetscHierarchy *h)
+{
+    int nl = 1;
     while (nl < h->o.max_levels && h->n[nl - 1] >= h->o.min_coarse_nodes) {
         MgTransfer *T = &h->T[nl - 1];
-        if ((st = mg_transfer_build(T, h->o.kind, h->lev[nl - 1].coord, h->n[nl - 1]))) return st;
+        int st = mg_transfer_build(T, h->o.kind, h->lev[nl - 1].coord, h->n[nl - 1]);
+        if (st) return st;
         const int m = T->n_coarse;
         if (m == 0 || m >= h->n[nl - 1]) break; /* no coarsening possible */
-        h->n[nl] = h->lev[nl].n = m;
+        h->n[nl] = h->n_global[nl] = h->lev[nl].n = m;
         h->lev[nl].coord = T->coarse_coord;
         ++nl;
     }
     h->nlev = nl;
+    return MPM_OK;
+}
+
+/* The same levels across ranks: every rank embeds its owned nodes, the
+ * coarse nodes are split by mg_coarse_ranks, and the stopping rule reads
+ * whole-scene counts, so every rank makes the same number of levels.
+ * Collective. */
+static int build_levels_ranks(PetscHierarchy *h, const PetscHierarchyRanks *r)
+{
+    int nl = 1;
+    while (nl < h->o.max_levels && h->n_global[nl - 1] >= h->o.min_coarse_nodes) {
+        MgTransfer *T = &h->T[nl - 1];
+        MgCoarseRanks *C = &h->C[nl - 1];
+        int st = comm_agree(r->comm, mg_transfer_build(T, h->o.kind, h->lev[nl - 1].coord, h->n[nl - 1]));
+        if (!st) st = mg_coarse_ranks(r->comm, r->decomp, nl, T, C);
+        if (st) return st;
+        if (C->total == 0 || C->total >= h->n_global[nl - 1]) break; /* no coarsening possible */
+        h->n[nl] = h->lev[nl].n = C->n_owned;
+        h->n_global[nl] = C->total;
+        h->first[nl] = C->first;
+        h->lev[nl].coord = C->owned_coord;
+        ++nl;
+    }
+    h->nlev = nl;
+    return MPM_OK;
+}
+
+int petsc_hierarchy_attach(PetscHierarchy *h, PC pc, int n, const int *coord, const NodeColoring *coloring,
+                           const PetscHierarchyRanks *ranks)
+{
+    if (!coord && n > 0) return mpm_error(MPM_EINTERNAL, "petsc hierarchy: needs the node coordinates");
+    if (ranks && !ranks->decomp) return mpm_error(MPM_EINTERNAL, "petsc hierarchy: needs the split across ranks");
+    h->vcycles = h->coarse_iters = h->coarse_capped = 0;
+    release_ranks(h);
+    h->comm = ranks ? ranks->comm : NULL;
+    h->n[0] = h->lev[0].n = n;
+    h->n_global[0] = ranks ? ranks->total : n;
+    h->first[0] = ranks ? ranks->first : 0;
+    h->lev[0].coord = coord;
+    int st = ranks ? build_levels_ranks(h, ranks) : build_levels(h);
+    if (st) return st;
+    const int nl = h->nlev;
     /* the colourings of the smoothed levels */
     for (int l = 0; l + 1 < nl && !st; ++l) {
         ShellLevel *L = &h->lev[l];
@@ -256,18 +356,27 @@ int petsc_hierarchy_attach(PetscHierarchy *h, PC pc, int n, const int *coord, co
             L->colp = &L->col;
         }
     }
+    if (ranks) st = comm_agree(ranks->comm, st);
     if (st) return st;
     if ((st = pk(PCSetType(pc, PCMG), MPM_EINTERNAL, "PCSetType(mg)"))) return st;
     if ((st = pk(PCMGSetLevels(pc, nl, NULL), MPM_EINTERNAL, "PCMGSetLevels"))) return st;
     for (int k = 0; k + 1 < nl && !st; ++k) {
         Mat P = NULL;
-        st = interpolation_matrix(&h->T[k], &P);
+        st = ranks ? interpolation_matrix_ranks(&h->T[k], &h->C[k], h->first[k], h->n_global[k], &P)
+                   : interpolation_matrix(&h->T[k], &P);
         /* PETSc level nl-1-k is fine level k */
         if (!st) st = pk(PCMGSetInterpolation(pc, nl - 1 - k, P), MPM_EINTERNAL, "PCMGSetInterpolation");
-        if (P) MatDestroy(&P); /* PCMG holds its own reference */
+        if (P && ranks && !st) h->P[k] = P; /* kept (PCMG holds its own reference too) for prepare */
+        else if (P) MatDestroy(&P);
     }
     if (!st && nl > 1) st = pk(PCMGSetGalerkin(pc, PC_MG_GALERKIN_BOTH), MPM_EINTERNAL, "PCMGSetGalerkin");
     if (!st) st = pk(PCMGSetNumberSmooth(pc, h->o.sweeps), MPM_EINTERNAL, "PCMGSetNumberSmooth");
+    /* prepare's restriction chain: a vector per level, the finest without storage */
+    if (ranks && !st)
+        st = pk(VecCreateMPIWithArray(PETSC_COMM_WORLD, 3, 3 * (PetscInt)n, PETSC_DECIDE, NULL, &h->down[0]),
+                MPM_EINTERNAL, "VecCreateMPIWithArray");
+    for (int k = 0; ranks && k + 1 < nl && !st; ++k)
+        st = pk(MatCreateVecs(h->P[k], &h->down[k + 1], NULL), MPM_EINTERNAL, "MatCreateVecs");
     return st;
 }
 
@@ -331,17 +440,32 @@ int petsc_hierarchy_prepare(PetscHierarchy *h, const double *b)
         h->cap_bbar = need;
     }
     const double *bb = b;
-    for (int l = 0; l < c; ++l) {
-        double *to = h->bbar[l % 2];
-        mg_restrict(&h->T[l], bb, to);
-        bb = to;
+    const PetscScalar *down = NULL;
+    int st = MPM_OK;
+    if (h->comm) { /* across ranks: R = P^T by PETSc, the ghost coarse nodes' shares reaching their owners */
+        st = pk(VecPlaceArray(h->down[0], b), MPM_EINTERNAL, "VecPlaceArray");
+        for (int l = 0; l < c && !st; ++l)
+            st = pk(MatMultTranspose(h->P[l], h->down[l], h->down[l + 1]), MPM_EINTERNAL, "MatMultTranspose");
+        VecResetArray(h->down[0]);
+        if (!st && c > 0) st = pk(VecGetArrayRead(h->down[c], &down), MPM_EINTERNAL, "VecGetArrayRead");
+        if (!st && c > 0) bb = down;
+    } else {
+        for (int l = 0; l < c; ++l) {
+            double *to = h->bbar[l % 2];
+            mg_restrict(&h->T[l], bb, to);
+            bb = to;
+        }
     }
     const ShellLevel *C = &h->lev[c];
     double norm2 = 0.0;
-    for (int i = 0; i < C->n; ++i) {
+    for (int i = 0; i < C->n && !st; ++i) {
         const double *D = C->dinv + 9 * i, *x = bb + 3 * i;
         for (int a = 0; a < 3; ++a) norm2 += x[a] * (D[3 * a] * x[0] + D[3 * a + 1] * x[1] + D[3 * a + 2] * x[2]);
     }
+    if (down) VecRestoreArrayRead(h->down[c], &down);
+    /* the whole scene's norm, summed in rank order */
+    if (h->comm && h->comm->sum(h->comm->ctx, &norm2, 1) && !st) st = MPM_EINTERNAL;
+    if (st) return st;
     return pk(KSPSetTolerances(h->coarse, 0.0, h->o.coarse_tol * sqrt(fmax(norm2, 0.0)), 1e300, h->o.coarse_max_iters),
               MPM_EINTERNAL, "KSPSetTolerances");
 }
@@ -374,12 +498,13 @@ void petsc_hierarchy_view(const PetscHierarchy *h, PC pc, InvView *out)
         Mat M = NULL;
         MatInfo info;
         double blocks = 0.0;
+        /* across ranks the whole scene's (MatGetInfo's sum is collective, as the view is) */
         if (pc && !PCMGGetSmoother(pc, h->nlev - 1 - l, &ksp) && !KSPGetOperators(ksp, &M, NULL) && M &&
-            !MatGetInfo(M, MAT_LOCAL, &info))
+            !MatGetInfo(M, h->comm ? MAT_GLOBAL_SUM : MAT_LOCAL, &info))
             blocks = info.nz_used / 9.0;
-        out->level[l].nodes = h->n[l];
+        out->level[l].nodes = h->n_global[l];
         out->level[l].blocks = (int64_t)blocks;
-        out->level[l].blocks_per_row_avg = h->n[l] ? blocks / h->n[l] : 0.0;
+        out->level[l].blocks_per_row_avg = h->n_global[l] ? blocks / h->n_global[l] : 0.0;
         out->level[l].blocks_per_row_max = 0; /* not counted */
     }
     inv_view_add(out, "vcycles", (double)h->vcycles);

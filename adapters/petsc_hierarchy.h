@@ -35,6 +35,7 @@
 
 #include "solvers/inverse_approx.h"
 #include "solvers/mg/embedding.h"
+#include "solvers/mg/embedding_ranks.h"
 
 typedef struct {
     MgEmbedding kind;
@@ -45,6 +46,22 @@ typedef struct {
 
 typedef struct PetscHierarchy PetscHierarchy;
 
+/* A hierarchy over MPI ranks (docs/distributed.md, "HOT across ranks"):
+ * each rank's fine nodes are its owned ones, numbered first .. first + n - 1
+ * of total in the fine matrix; the coarse levels are split by
+ * mg_coarse_ranks, the interpolations are parallel matrices, PETSc's
+ * MatPtAP makes the coarse operators across ranks. The coloured SGS
+ * smoother then sweeps each rank's own rows (the local diagonal block of
+ * the level's matrix, a processor-block Gauss-Seidel; the Richardson
+ * iteration around it takes the residual of the whole matrix), and the
+ * coarse CG's block Jacobi is each rank's rows'. On one rank it is the
+ * one-process hierarchy. */
+typedef struct {
+    const CommOps *comm;
+    const Decomposition *decomp;
+    int first, total;
+} PetscHierarchyRanks;
+
 int petsc_hierarchy_create(const PetscHierarchyOptions *options, PetscHierarchy **out);
 void petsc_hierarchy_destroy(PetscHierarchy *h);
 
@@ -52,12 +69,15 @@ void petsc_hierarchy_destroy(PetscHierarchy *h);
  * block size 3) a PCMG on the embedding levels of the n fine nodes at
  * integer coordinates `coord` (sorted by node_order_key; `coloring` their
  * colouring, or NULL to build one): levels, interpolations, Galerkin coarse
- * operators. Before KSPSetFromOptions. */
-int petsc_hierarchy_attach(PetscHierarchy *h, PC pc, int n, const int *coord, const NodeColoring *coloring);
+ * operators. Before KSPSetFromOptions. Across ranks (`ranks` not NULL; else
+ * NULL) n and coord are this rank's owned nodes; collective. */
+int petsc_hierarchy_attach(PetscHierarchy *h, PC pc, int n, const int *coord, const NodeColoring *coloring,
+                           const PetscHierarchyRanks *ranks);
 /* The coarse solve and, with the SGS smoother, the level smoothers. After
  * KSPSetFromOptions, before KSPSetUp. */
 int petsc_hierarchy_configure(PetscHierarchy *h, PC pc);
-/* Before a PCApply on input b (3n): the coarse solve's tolerance. */
+/* Before a PCApply on input b (3n; across ranks the owned nodes'): the
+ * coarse solve's tolerance. Collective across ranks. */
 int petsc_hierarchy_prepare(PetscHierarchy *h, const double *b);
 /* After it: adds the coarse solve's iterations to *coarse_iters. */
 int petsc_hierarchy_finish(PetscHierarchy *h, long *coarse_iters);

@@ -25,6 +25,7 @@
 
 #include "core/bsr.h"
 #include "core/dist/comm_ops.h"
+#include "core/dist/decomposition.h"
 #include "core/grid.h"
 #include "core/material.h"
 #include "core/particles.h"
@@ -90,6 +91,7 @@ typedef struct StepProblem {
      * the ranks. A failed communication sets comm_failed. */
     const CommOps *comm;
     const unsigned char *owned; /* per node: 1 when this rank owns it (comm only) */
+    const Decomposition *decomp; /* the split: the owner of any grid position (comm only) */
     double n_global;     /* the active nodes of every rank (the CN rule's count) */
     int comm_failed;
     double *halo;        /* 3 per node: an incoming field with its ghosts */

@@ -167,6 +167,7 @@ int step_begin(Simulation *sim)
     estimate_volumes(sim);
     sim->pb.comm = sim->comm;
     sim->pb.owned = sim->comm ? sim->dist.owned : NULL;
+    sim->pb.decomp = sim->comm ? &sim->decomp : NULL;
     sim->pb.comm_failed = 0;
     st = problem_prepare(&sim->pb, &sim->grid, &sim->st, &sim->p, sc->materials, sc->n_materials, sim->dt, sc->gravity);
     if (!st && sim->pb.comm_failed) st = mpm_error(MPM_EINTERNAL, "t = %.9g s: a halo exchange failed", sim->t);

@@ -24,6 +24,7 @@
 #include "core/bsr.h"
 #include "core/deadline.h"
 #include "core/dist/comm_ops.h"
+#include "core/dist/decomposition.h"
 #include "core/event_log.h"
 #include "core/node_order.h"
 #include "solvers/krylov/linear_op.h"
@@ -51,6 +52,7 @@ typedef struct {
      * an INV_DISTRIBUTED implementation is set up with comm. */
     const CommOps *comm;
     const unsigned char *owned;
+    const Decomposition *decomp; /* the owner of any grid position (coarse levels' nodes) */
 } InvSetupInput;
 
 /* Capability flags (InvApprox.caps, set by create from the options). */

@@ -171,8 +171,9 @@ int solve_setup_inverse(SolveCtx *c, const Bsr *H, const double *diag, const Lin
 {
     StepProblem *pb = c->pb;
     if (pb->comm && !(c->inv->caps & INV_DISTRIBUTED))
-        return mpm_error(MPM_EINPUT, "inverse approximation %s has no form across ranks yet (docs/distributed.md)",
-                         c->inv->ops->name);
+        return mpm_error(MPM_EINPUT, "inverse approximation %s has no form across ranks yet%s (docs/distributed.md)",
+                         c->inv->ops->name,
+                         !strcmp(c->inv->ops->name, "mg") ? "; HOT's across ranks is the preset hot-petsc" : "");
     InvSetupInput in = {
         .n_nodes = pb->n_nodes,
         .H = H,
@@ -185,6 +186,7 @@ int solve_setup_inverse(SolveCtx *c, const Bsr *H, const double *diag, const Lin
         .deadline = c->set->deadline,
         .comm = pb->comm,
         .owned = pb->owned,
+        .decomp = pb->decomp,
     };
     return inv_setup(c->inv, &in);
 }

@@ -15,7 +15,7 @@
 # mpirun_ranks' timeout turns a hang into a failure.
 . "$(dirname "$0")/../common/shell_harness.sh"
 command -v mpirun >/dev/null || skip "mpirun not found"
-for name in test_dist_halo test_dist_problem test_dist_solve test_dist_steps; do
+for name in test_dist_halo test_dist_problem test_dist_hierarchy test_dist_solve test_dist_steps; do
   helper="$(dirname "$bin")/tests/$name"
   [ -x "$helper" ] || { echo "FAIL: $helper not built"; fails=$((fails + 1)); continue; }
   ranks_list="2 3"

@@ -6,7 +6,8 @@
 # one-process run's rows of steps.csv (frame, step, t, dt, particles,
 # active nodes, outer and linear iterations, line-search evaluations,
 # status) exactly and its residuals to 1e-6; with pn-gamg-pcg (PETSc's GAMG
-# on the parallel matrix: its aggregates differ with the split) every step
+# on the parallel matrix: its aggregates differ with the split) and HOT
+# (hot-petsc: its Gauss-Seidel sweeps each rank's rows) every step
 # converges, the steps and particles are the one-process run's, and each
 # step's outer iterations are within 2 of it. Rank 0 alone writes the
 # folder, and run.json records the ranks and each rank's particles, which
@@ -15,7 +16,8 @@
 # reader reads as the one-process run's particles and grid nodes. Re-cuts
 # past --rebalance-above keep drop balanced without changing its steps. Options
 # that follow one trajectory are refused with exit 2 on every rank, and so
-# is a solver whose inverse has no form across ranks.
+# is a solver whose inverse has no form across ranks (the in-house HOT's
+# refusal names hot-petsc).
 . "$(dirname "$0")/../common/shell_harness.sh"
 command -v mpirun >/dev/null || skip "mpirun not found"
 R=(run --scene bar3 --scale 4 --frames 2 --threads 1 --quiet)
@@ -49,10 +51,10 @@ assert all(s >= 0 for s in dist["halo_seconds_per_rank"] + dist["collective_seco
 print("ok")
 PY
 }
-for solver in pn-pcg-mf lbfgs:jacobi pn-pcg pn-gamg-pcg; do
+for solver in pn-pcg-mf lbfgs:jacobi pn-pcg pn-gamg-pcg hot-petsc; do
   name=${solver%%:*}
   same=1
-  [ "$solver" = pn-gamg-pcg ] && same=0
+  case $solver in pn-gamg-pcg | hot-petsc) same=0 ;; esac
   "$bin" "${R[@]}" --solver "$solver" --out "$tmp/$name-1"
   check "$solver on one process: exit 0" test $? -eq 0
   for ranks in 2 3; do
@@ -172,4 +174,7 @@ check "rank 0 cannot make its folder: exit 2 on every rank, no hang ($rc: $(head
 mpirun_ranks -np 2 "$bin" "${R[@]}" --solver pn-sgs-pcg --out "$tmp/asm" >"$tmp/out" 2>&1
 rc=$?
 check "a solver without a form across ranks: exit 2 ($rc), one line per rank" test $rc -eq 2 -a "$(grep -c '^mpmbench: error: .*has no form across ranks' "$tmp/out")" -eq 2
+mpirun_ranks -np 2 "$bin" "${R[@]}" --solver hot --out "$tmp/hot" >"$tmp/out" 2>&1
+rc=$?
+check "hot (the in-house V-cycle) across ranks: exit 2 ($rc), naming hot-petsc on every rank" test $rc -eq 2 -a "$(grep -c '^mpmbench: error: inverse approximation mg has no form across ranks yet; HOT.s across ranks is the preset hot-petsc' "$tmp/out")" -eq 2
 finish

@@ -239,6 +239,9 @@ int main(void)
     check_solver(&comm, "lbfgs-gamg", 0);
     check_solver(&comm, "pn:petsc:pc_type=hypre", 0); /* BoomerAMG through PETSc's parallel matrix */
     check_solver(&comm, "pn:petsc:pc_type=ml", 0);
+    /* HOT: its levels split over the ranks; one rank's is the one-process hierarchy */
+    check_solver(&comm, "hot-petsc", comm.ranks == 1);
+    check_solver(&comm, "hot-petsc:petsc_smoother=petsc", comm.ranks == 1);
     check_petsc_matrix(&comm, "");
     check_petsc_matrix(&comm, "petsc_mat_type=baij,pc_type=bjacobi"); /* GAMG takes no BAIJ in PETSc 3.18 */
     check_refused(&comm);
