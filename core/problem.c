@@ -953,7 +953,8 @@ double problem_cn_residual(const StepProblem *pb, const double *g)
     if (!pb->comm) return sqrt(sum / pb->n_nodes);
     /* ghosts hold zeros: the local sum is the owned nodes' share */
     StepProblem *mut = (StepProblem *)pb; /* the failure flag only */
-    return sqrt(ranks_sum(mut, sum) / pb->n_global);
+    const double total = ranks_sum(mut, sum);
+    return pb->n_global > 0 ? sqrt(total / pb->n_global) : 0.0; /* no node on any rank: as one process */
 }
 
 double problem_tau(const StepProblem *pb, double eps)

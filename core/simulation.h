@@ -38,6 +38,8 @@ typedef struct {
     DistGrid dist;        /* this rank's owned nodes and ghosts */
     double rebalance_above; /* > 0: a new cut when the busiest rank's particles pass this times the mean */
     int recuts;             /* new cuts made so far (dist_rebalance) */
+    int uncut;              /* the split was made with no particle (all on rank 0): dist_rebalance cuts
+                               after the first emission, whatever rebalance_above */
     double worst_imbalance; /* the largest busiest-over-mean particle count after a step's migration */
 } Simulation;
 

@@ -39,7 +39,8 @@ static int apply_collider_friction(Simulation *sim, const double *dv)
     const Scene *sc = sim->scene;
     StepProblem *pb = &sim->pb;
     Grid *g = &sim->grid;
-    if (!sim->has_friction || pb->n_dirichlet == 0) return MPM_OK;
+    /* over ranks every rank takes part (the gradient's halo sum), Dirichlet nodes or not */
+    if (!sim->has_friction || (!sim->comm && pb->n_dirichlet == 0)) return MPM_OK;
     int st = grow_node_buffer(&sim->grad, &sim->cap_grad, g->n, "friction gradient");
     if (st) return st;
     int nd = pb->n_dirichlet;
@@ -50,7 +51,8 @@ static int apply_collider_friction(Simulation *sim, const double *dv)
     const double t = sim->t, dx = g->dx;
 #pragma omp parallel for schedule(static)
     for (int i = 0; i < g->n; ++i) {
-        if (pb->bc[i] != BC_SLIP) continue;
+        /* a ghost's v^{n+1} comes from its owner after this (its mass and gradient are 0 here) */
+        if (pb->bc[i] != BC_SLIP || (pb->owned && !pb->owned[i])) continue;
         double x[3] = {g->coord[3 * i] * dx, g->coord[3 * i + 1] * dx, g->coord[3 * i + 2] * dx};
         for (int c = 0; c < sc->n_colliders; ++c) {
             const Collider *col = &sc->colliders[c];
@@ -68,28 +70,37 @@ static int apply_collider_friction(Simulation *sim, const double *dv)
 
 /* G2P and the position update the scene chose. The default (APIC,
  * forward Euler) is the original call, so existing scenes are unchanged. */
-static void grid_to_particles(Simulation *sim)
+static int grid_to_particles(Simulation *sim)
 {
     const Scene *sc = sim->scene;
     if (sc->transfer == TRANSFER_APIC && sc->position_update == POSITION_FORWARD_EULER) {
         transfer_g2p(&sim->grid, &sim->st, &sim->p, sim->vnew, sim->dt, sc->apic_ratio);
-        return;
+        return MPM_OK;
     }
     G2POptions opt = {.kind = sc->transfer,
                       .apic_ratio = sc->apic_ratio,
                       .flip_alpha = sc->flip_alpha,
                       .advect = sc->position_update == POSITION_FORWARD_EULER};
     transfer_g2p_opts(&sim->grid, &sim->st, &sim->p, sim->vnew, sim->dt, &opt);
-    if (sc->position_update == POSITION_BACKWARD_EULER)
-        position_update_backward_euler(&sim->grid, &sim->st, &sim->p, sim->vnew, sim->dt, &sim->pos_stats);
+    if (sc->position_update != POSITION_BACKWARD_EULER) return MPM_OK;
+    /* over ranks the velocity field needs the nodes other ranks have around this one's */
+    if (sim->comm) return dist_backward_euler(sim);
+    position_update_backward_euler(&sim->grid, &sim->st, &sim->p, sim->vnew, sim->dt, &sim->pos_stats);
+    return MPM_OK;
 }
 
 /* Gast et al. 2015 section 6.1 step 2, first step only, after the P2G. */
-static void estimate_volumes(Simulation *sim)
+static int estimate_volumes(Simulation *sim)
 {
-    if (!sim->scene->volumes_from_density || sim->volumes_done) return;
-    transfer_volumes_from_density(&sim->grid, &sim->st, &sim->p);
+    if (!sim->scene->volumes_from_density || sim->volumes_done) return MPM_OK;
+    Grid *g = &sim->grid;
+    /* over ranks the particles read their ghost nodes' whole mass, the owners' */
+    if (sim->comm && sim->comm->halo_copy(sim->comm->ctx, g->mass, 1)) return MPM_EINTERNAL;
+    transfer_volumes_from_density(g, &sim->st, &sim->p);
+    for (int i = 0; sim->comm && i < g->n; ++i)
+        if (!sim->dist.owned[i]) g->mass[i] = 0.0; /* ghosts carry no mass (dist_p2g_halo) */
     sim->volumes_done = 1;
+    return MPM_OK;
 }
 
 /* ---- end of the section 6 options ---- */
@@ -164,7 +175,7 @@ int step_begin(Simulation *sim)
     if (sim->comm && (st = dist_p2g_halo(sim))) return st;
     st = ranks_agree(sim, check_node_masses(sim));
     if (st) return st;
-    estimate_volumes(sim);
+    if ((st = estimate_volumes(sim))) return st;
     sim->pb.comm = sim->comm;
     sim->pb.owned = sim->comm ? sim->dist.owned : NULL;
     sim->pb.decomp = sim->comm ? &sim->decomp : NULL;
@@ -251,13 +262,18 @@ int step_end(Simulation *sim, const double *dv)
     if (fst) return fst;
     /* over ranks: the solver's dv is zero at the ghosts; G2P reads their owners' v^{n+1} */
     if (sim->comm && (fst = sim->comm->halo_copy(sim->comm->ctx, sim->vnew, 3))) return fst;
-    grid_to_particles(sim);
+    if ((fst = grid_to_particles(sim))) return fst;
     if (sc->needs_plasticity) {
         int st = plasticity_apply(&sim->p, sc->materials, sc->n_materials);
         if (st) return st;
     }
     if (sc->n_sources) { /* particle sources emit after the step [t, t + dt] (SPEC 2 item 8) */
-        int st = source_emit_all(sc->sources, sc->n_sources, &sim->p, sim->t, sim->dt);
+        /* over ranks every rank emits the same particles and keeps its own */
+        const size_t before = sim->p.n;
+        double total = (double)before;
+        if (sim->comm && sim->comm->sum(sim->comm->ctx, &total, 1)) return MPM_EINTERNAL;
+        int st = ranks_agree(sim, source_emit_all(sc->sources, sc->n_sources, &sim->p, sim->t, sim->dt));
+        if (!st && sim->comm) st = dist_keep_emitted(sim, before, total);
         if (st) return st;
     }
     sim->t += sim->dt;

@@ -110,6 +110,19 @@ int decomposition_balance(const int *base, size_t n, int ranks, Decomposition *d
     return status;
 }
 
+int decomposition_all_on_first(int ranks, Decomposition *d)
+{
+    d->ranks = 0;
+    d->first_key = NULL;
+    if (ranks < 1) return mpm_error(MPM_EINPUT, "ranks: must be >= 1, got %d", ranks);
+    d->first_key = malloc(sizeof(uint64_t) * ((size_t)ranks + 1));
+    if (!d->first_key) return mpm_error(MPM_EINTERNAL, "out of memory: decomposition over %d ranks", ranks);
+    d->ranks = ranks;
+    d->first_key[0] = 0;
+    for (int r = 1; r <= ranks; ++r) d->first_key[r] = UINT64_MAX; /* curve keys stay below 2^63 */
+    return MPM_OK;
+}
+
 int decomposition_owner(const Decomposition *d, const int B[3])
 {
     uint64_t k = block_curve_key(B);

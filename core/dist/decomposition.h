@@ -54,6 +54,11 @@ int decomposition_particle_blocks(const int *base, size_t n, uint64_t **block_ke
  * particle counts; the errors of decomposition_balance. */
 int decomposition_cut(const uint64_t *block_key, const size_t *block_count, size_t nb, int ranks, Decomposition *d);
 
+/* Every block to rank 0 (the others own empty intervals): the split of a
+ * scene that has no particle yet (filled by sources); its first real cut
+ * comes from dist_rebalance once there are particles. */
+int decomposition_all_on_first(int ranks, Decomposition *d);
+
 /* The rank owning the block at block coordinates B. */
 int decomposition_owner(const Decomposition *d, const int B[3]);
 

@@ -11,13 +11,6 @@
 int sim_distribute(Simulation *sim, const CommOps *comm)
 {
     const Scene *sc = sim->scene;
-    const char *missing = sc->transfer == TRANSFER_MLS                        ? "MLS transfers"
-                          : sc->volumes_from_density                         ? "grid-density particle volumes"
-                          : sc->n_sources                                    ? "particle sources"
-                          : sim->has_friction                                ? "collider friction"
-                          : sc->position_update == POSITION_BACKWARD_EULER   ? "backward-Euler position updates"
-                                                                             : NULL;
-    if (missing) return mpm_error(MPM_EINPUT, "%s: %s are not distributed over ranks yet", sc->name, missing);
     Particles *p = &sim->p;
     size_t n = p->n;
     int *base = calloc(3 * (n ? n : 1), sizeof(int));
@@ -25,8 +18,11 @@ int sim_distribute(Simulation *sim, const CommOps *comm)
     double *scratch = malloc(sizeof(double) * 9 * (n ? n : 1));
     int st = base && perm && scratch ? MPM_OK : mpm_error(MPM_EINTERNAL, "out of memory: distributing %zu particles", n);
     for (size_t k = 0; !st && k < 3 * n; ++k) base[k] = (int)floor(p->x[k] / sc->dx - 0.5);
-    /* every rank splits the same particles the same way: no communication */
-    if (!st) st = decomposition_balance(base, n, comm->ranks, &sim->decomp);
+    /* every rank splits the same particles the same way: no communication;
+     * a scene its sources fill starts on rank 0 and is cut when they emit */
+    sim->uncut = n == 0 && sc->n_sources > 0;
+    if (!st) st = sim->uncut ? decomposition_all_on_first(comm->ranks, &sim->decomp)
+                             : decomposition_balance(base, n, comm->ranks, &sim->decomp);
     if (!st) {
         size_t kept = 0;
         for (size_t k = 0; k < n; ++k) kept += decomposition_node_owner(&sim->decomp, base + 3 * k) == comm->rank;
@@ -165,6 +161,22 @@ int dist_migrate(Simulation *sim, size_t *sent)
     return st;
 }
 
+int dist_keep_emitted(Simulation *sim, size_t n_before, double total_before)
+{
+    Particles *p = &sim->p;
+    const double dx = sim->scene->dx;
+    size_t kept = n_before;
+    for (size_t k = n_before; k < p->n; ++k) {
+        int base[3];
+        for (int d = 0; d < 3; ++d) base[d] = (int)floor(p->x[3 * k + d] / dx - 0.5);
+        /* one process numbers them after the whole scene's particles, in emission order */
+        if (p->id) p->id[k] = (size_t)total_before + (k - n_before);
+        if (decomposition_node_owner(&sim->decomp, base) == sim->comm->rank) move_particle(p, k, kept++);
+    }
+    p->n = kept;
+    return MPM_OK;
+}
+
 /* Every rank's particle blocks to every rank: each rank's blocks lie in its
  * own key interval, and the intervals follow the ranks, so the blocks come
  * in curve order, each once (checked). */
@@ -224,7 +236,8 @@ int dist_rebalance(Simulation *sim)
     const double imbalance = total > 0 ? most * R / total : 1.0;
     if (imbalance > sim->worst_imbalance) sim->worst_imbalance = imbalance;
     /* the same counts on every rank: all of them cut again, or none */
-    if (st || sim->rebalance_above <= 0 || imbalance <= sim->rebalance_above) return st;
+    const int first_cut = sim->uncut && total > 0;
+    if (st || (!first_cut && (sim->rebalance_above <= 0 || imbalance <= sim->rebalance_above))) return st;
     const Particles *p = &sim->p;
     const double dx = sim->scene->dx;
     int *base = malloc(sizeof(int) * 3 * (p->n ? p->n : 1));
@@ -255,6 +268,7 @@ int dist_rebalance(Simulation *sim)
     decomposition_free(&sim->decomp);
     sim->decomp = cut;
     sim->recuts++;
+    sim->uncut = 0;
     size_t sent = 0;
     st = dist_migrate(sim, &sent);
     sim->dist.migrated += sent;

@@ -15,10 +15,9 @@
 
 /* Splits sim (initialised by sim_init on every rank from the same scene)
  * over comm's ranks: the decomposition of its particles, then only this
- * rank's particles kept. Collective. MPM_EINPUT for what has no
- * distributed form yet (MLS transfers, grid-density volumes, sources,
- * collider friction, backward-Euler position updates) and for more ranks
- * than blocks. */
+ * rank's particles kept. Collective. MPM_EINPUT for more ranks than
+ * blocks. A scene with no particle before its
+ * sources emit starts with every block on rank 0 (sim->uncut). */
 int sim_distribute(Simulation *sim, const CommOps *comm);
 
 /* After P2G on a rank's grid: mass and momentum summed into the owners,
@@ -39,6 +38,19 @@ int dist_migrate(Simulation *sim, size_t *sent);
  * which block granularity can give, or fewer particle blocks than ranks
  * leaves the old one). Collective. */
 int dist_rebalance(Simulation *sim);
+
+/* After every rank's sources emitted the same particles (indices n_before
+ * onward; emission is a function of the time and the sources only): their
+ * identities as one process numbers them (from total_before, the whole
+ * scene's count before the emission) and only those this rank owns kept,
+ * in emission order. */
+int dist_keep_emitted(Simulation *sim, size_t n_before, double total_before);
+
+/* Backward-Euler positions (position_update.h) after G2P over ranks, on
+ * this rank's grid grown by the nodes one node around it that other ranks
+ * have, with their v^{n+1} (core/dist/dist_position.c); sim->pos_stats
+ * gets this rank's counts. Collective. */
+int dist_backward_euler(Simulation *sim);
 
 /* The default of rebalance_above: a rank 20 % over the mean slows every
  * step by as much, while a cut costs an exchange of the block counts and

@@ -333,16 +333,18 @@ static int write_step(void *ctx, const Simulation *sim, int frame, int step, con
 {
     RunOutput *o = ctx;
     FILE *f = o->steps_csv;
-    /* over ranks: the whole scene's particles and (owned) nodes; every rank sums, rank 0 writes */
-    double counts[2] = {(double)sim->p.n, o->comm ? (double)sim->dist.n_owned : (double)si->active_nodes};
-    if (o->comm && o->comm->sum(o->comm->ctx, counts, 2)) return MPM_EINTERNAL;
+    /* over ranks: the whole scene's particles and (owned) nodes, and the blocks every rank
+     * assembled (ghost rows included); every rank sums, rank 0 writes */
+    double counts[3] = {(double)sim->p.n, o->comm ? (double)sim->dist.n_owned : (double)si->active_nodes,
+                        (double)ss->hessian_blocks};
+    if (o->comm && o->comm->sum(o->comm->ctx, counts, 3)) return MPM_EINTERNAL;
     /* t and dt read back as the same doubles (--dt-from replays them) */
     csv_write_name(f, o->scene->name);
     fputc(',', f);
     csv_write_name(f, o->solver->name);
     fprintf(f, ",%d,%d,%.17g,%.17g,%zu,%d,%lld,%d,%ld,%d,%.6e,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%ld,",
             frame, step, si->t, si->dt, (size_t)counts[0], (int)counts[1],
-            (long long)ss->hessian_blocks, ss->outer_iters, ss->linear_iters, ss->ls_evals, ss->residual,
+            (long long)counts[2], ss->outer_iters, ss->linear_iters, ss->ls_evals, ss->residual,
             solve_status_name(ss->status), si->wall_s, si->begin_s, ss->assemble_s, ss->setup_s, ss->solve_s,
             ss->linesearch_s, si->end_s, o->threads, ss->inner_iters);
     fprintf(f, "%.9g,", ss->energy_increase_max);

@@ -166,6 +166,65 @@ assert d <= 5e-5, d
 print("ok")
 PY
 check "re-cuts: made, balanced, the one-process steps and particles ($(tail -1 "$tmp/cmp"))" grep -qx ok "$tmp/cmp"
+# what one process alone ran before, over 2 and 3 ranks against one
+# process (--vtk: the last frame's particles by id). Exact (the one-process
+# rows, positions to 1e-6 m, float32 files): backward-Euler positions on
+# bar3 (each rank asks the owners for the nodes one node around its grid;
+# without them 1.8e-5 m), MLS transfers on bar3, and sauce's source (the
+# scene starts empty on rank 0 and is cut at its first emission; every
+# rank emits the same particles and keeps its own). Within a band (solves
+# that round differently on contact: every step converged, the same steps
+# and particles, outer iterations within 2 a step, positions within 1e-3 m,
+# about 0.05 dx; measured below 5e-4 m): snowball-drop past its impact
+# (snow plasticity, grid-density volumes, backward Euler, PIC/FLIP) and
+# wheel at scale 6 with a slip ground of friction 0.5 (tightened to eps
+# 1e-10; measured 2e-5 m on 2 ranks).
+if /usr/bin/python3 -c "import vtk" 2>/dev/null; then
+  band_case() { # name exact(1|0) run-args...
+    local name=$1 exact=$2; shift 2
+    "$bin" run --threads 1 --quiet "$@" --vtk "$tmp/$name-v1" --out "$tmp/$name-1" >"$tmp/out" 2>&1
+    rc=$?
+    check "$name on one process: exit 0 ($(head -c 300 "$tmp/out"))" test $rc -eq 0
+    for ranks in 2 3; do
+      mpirun_ranks -np $ranks "$bin" run --threads 1 --quiet "$@" --vtk "$tmp/$name-v$ranks" --out "$tmp/$name-$ranks" >"$tmp/out" 2>&1
+      rc=$?
+      check "$name on $ranks ranks: exit 0 ($(head -c 300 "$tmp/out"))" test $rc -eq 0
+      /usr/bin/python3 - "$tmp/$name" $ranks $exact >"$tmp/cmp" 2>&1 <<'PY'
+import csv, glob, sys, numpy as np, vtk
+from vtk.util.numpy_support import vtk_to_numpy
+base, ranks, exact = sys.argv[1], int(sys.argv[2]), sys.argv[3] == "1"
+ra, rb = list(csv.DictReader(open(f"{base}-1/steps.csv"))), list(csv.DictReader(open(f"{base}-{ranks}/steps.csv")))
+assert len(ra) == len(rb) > 0, (len(ra), len(rb))
+keys = ["frame", "step", "t", "dt", "particles", "active_nodes", "outer_iters", "linear_iters", "status"] if exact else ["frame", "step", "particles", "status"]
+for x, y in zip(ra, rb):
+    d = [(k, x[k], y[k]) for k in keys if x[k] != y[k]]
+    assert not d, (x["frame"], x["step"], d)
+    assert y["status"] == "converged" and abs(int(x["outer_iters"]) - int(y["outer_iters"])) <= 2, (x["step"], x["outer_iters"], y["outer_iters"])
+def load(pattern):
+    x, i = [], []
+    for f in sorted(glob.glob(pattern)):
+        r = vtk.vtkXMLPolyDataReader(); r.SetFileName(f); r.Update(); o = r.GetOutput()
+        x.append(vtk_to_numpy(o.GetPoints().GetData())); i.append(vtk_to_numpy(o.GetPointData().GetArray("id")))
+    x, i = np.concatenate(x), np.concatenate(i)
+    return x[np.argsort(i)], np.sort(i)
+last = sorted(glob.glob(f"{base}-v1/particles_*.vtp"))[-1].rsplit("_", 1)[1][:-4]
+xa, ia = load(f"{base}-v1/particles_{last}.vtp")
+xb, ib = load(f"{base}-v{ranks}/particles_{last}_r*.vtp")
+assert np.array_equal(ia, ib), ("ids", len(ia), len(ib))
+d = float(np.abs(xa - xb).max())
+assert d <= (1e-6 if exact else 1e-3), ("positions", d)
+print("ok", d)
+PY
+      check "$name on $ranks ranks: $( [ $exact = 1 ] && echo 'the one-process rows and positions' || echo 'within the band') ($(tail -1 "$tmp/cmp"))" grep -q '^ok' "$tmp/cmp"
+    done
+  }
+  band_case backward-euler 1 --scene bar3 --scale 4 --frames 2 --solver pn-pcg-mf --set position_update=backward_euler
+  band_case mls 1 --scene bar3 --scale 4 --frames 2 --solver pn-pcg-mf --set transfer=mls
+  band_case sauce 1 --scene sauce --scale 4 --frames 6 --solver pn-pcg
+  band_case snow 0 --scene snowball-drop --scale 4 --frames 16 --solver pn-pcg-mf
+  band_case friction 0 --scene wheel --scale 6 --frames 1 --solver pn-pcg --eps 1e-10 --set colliders.1.type=slip --set colliders.1.friction=0.5
+  check "sauce on 2 ranks: cut at its first emission (run.json recuts >= 1)" python3 -c "import json,sys; d=json.load(open('$tmp/sauce-2/run.json'))['distributed']; sys.exit(not (d['recuts'] >= 1 and min(d['particles_per_rank']) > 0))"
+fi
 # an error on one rank only: rank 0 alone makes the output folder; the
 # others must stop with it, not wait in the first step (a hang was 124)
 mpirun_ranks -np 2 "$bin" "${R[@]}" --solver pn-pcg --out /proc/mpmbench-none/x >"$tmp/out" 2>&1

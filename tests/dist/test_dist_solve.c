@@ -18,7 +18,10 @@
  * lbfgs-gamg, BoomerAMG and ML through PETSc): they aggregate within each
  * rank, so they are other preconditioners than one process's. Checked:
  * they converge, the outer iterations within 2 of one process's and the
- * linear ones at most twice (+4).
+ * linear ones at most twice (+4). HOT through PETSc (hot-petsc, with its
+ * coloured SGS or PETSc's smoother): on one rank the one-process hierarchy
+ * (the same iterations, dv within 1e-8); on more, its Gauss-Seidel sweeps
+ * each rank's rows, so within the same band.
  *
  * Every solver: the ranks' dv gathered into the whole scene's nodes has a
  * CN residual below eps on the whole scene's problem (the split solved the

@@ -55,6 +55,21 @@ static uint64_t rng_next(unsigned long long *s)
 
 /* Two clusters of different density and a sparse haze, dx = 1: about 200
  * particle blocks with very different counts. */
+/* A scene with no particle yet: every block, near and far, negative
+ * coordinates included, belongs to rank 0 (its first cut comes later) */
+static void check_all_on_first(void)
+{
+    Decomposition d;
+    CHECK(decomposition_all_on_first(4, &d) == MPM_OK, "all on first: %s", mpm_last_error());
+    const int blocks[4][3] = {{0, 0, 0}, {-7, 3, 100}, {1 << 19, -(1 << 19), 5}, {(1 << 20) - 1, (1 << 20) - 1, (1 << 20) - 1}};
+    for (int b = 0; b < 4; ++b)
+        CHECK(decomposition_owner(&d, blocks[b]) == 0, "all on first: block (%d, %d, %d) on rank %d", blocks[b][0],
+              blocks[b][1], blocks[b][2], decomposition_owner(&d, blocks[b]));
+    decomposition_free(&d);
+    CHECK(decomposition_all_on_first(0, &d) == MPM_EINPUT, "all on first: 0 ranks accepted");
+    mpm_clear_error();
+}
+
 static void make_cloud(Particles *p, size_t n)
 {
     unsigned long long s = 42;
@@ -211,6 +226,7 @@ static void check_census(const Stencils *st, const Grid *g)
 int main(void)
 {
     check_curve_keys();
+    check_all_on_first();
     Particles p = {0};
     Grid g = {0};
     Stencils st = {0};
