@@ -31,6 +31,7 @@ typedef struct {
     const NodeColoring *colp; /* &col, or the fine level's given colouring */
     double *diag, *dinv, *work; /* 9n, 9n, 6n */
     int cap;
+    int l1; /* a smoothed level across ranks: the l1 term on its diagonal (add_l1_term) */
 } ShellLevel;
 
 struct PetscHierarchy {
@@ -163,18 +164,47 @@ static int level_reserve(ShellLevel *L, int n)
     return MPM_OK;
 }
 
+/* Across ranks a Gauss-Seidel sweep of each rank's own rows (a hybrid,
+ * processor-block smoother) can diverge where the ranks' couplings are
+ * strong; it cannot once each row's diagonal gains the absolute sum of the
+ * row's entries in other ranks' columns (the l1 smoother of Baker,
+ * Falgout, Kolev and Yang 2011, "Multigrid smoothers for ultraparallel
+ * computing", §5-6), which keeps the smoother convergent and the V-cycle
+ * SPD for an SPD matrix. On one rank there are no such entries: the
+ * one-process smoother exactly. Ao: the rows' off-rank part (3n rows). */
+static int add_l1_term(Mat Ao, int n, double *diag)
+{
+    PetscInt rows = 0;
+    const PetscInt *ia = NULL, *ja = NULL;
+    PetscBool done = PETSC_FALSE;
+    const PetscScalar *v = NULL;
+    int st = pk(MatGetRowIJ(Ao, 0, PETSC_FALSE, PETSC_FALSE, &rows, &ia, &ja, &done), MPM_EINTERNAL, "MatGetRowIJ");
+    if (!st && (!done || rows != 3 * (PetscInt)n)) st = mpm_error(MPM_EINTERNAL, "petsc hierarchy: off-rank rows");
+    if (!st) st = pk(MatSeqAIJGetArrayRead(Ao, &v), MPM_EINTERNAL, "MatSeqAIJGetArrayRead");
+    for (PetscInt r = 0; !st && r < rows; ++r) {
+        double sum = 0.0;
+        for (PetscInt q = ia[r]; q < ia[r + 1]; ++q) sum += fabs(v[q]);
+        diag[9 * (r / 3) + 4 * (r % 3)] += sum; /* entry (a, a) of node r/3's block */
+    }
+    if (v) MatSeqAIJRestoreArrayRead(Ao, &v);
+    if (done) MatRestoreRowIJ(Ao, 0, PETSC_FALSE, PETSC_FALSE, &rows, &ia, &ja, &done);
+    return st;
+}
+
 /* The shell PC's setup: the level's operator into block CSR, its block
  * diagonal inverse, and (smoothed levels) its colouring. */
 static PetscErrorCode shell_setup(PC pc)
 {
     ShellLevel *L = NULL;
     Mat M = NULL;
+    Mat Ao = NULL;
     PetscBool parallel = PETSC_FALSE;
     PetscErrorCode ierr = PCShellGetContext(pc, &L);
     if (!ierr) ierr = PCGetOperators(pc, &M, NULL);
     if (!ierr) ierr = PetscObjectTypeCompare((PetscObject)M, MATMPIAIJ, &parallel);
-    /* across ranks: this rank's rows and columns only (the local diagonal block) */
-    if (!ierr && parallel) ierr = MatMPIAIJGetSeqAIJ(M, &M, NULL, NULL);
+    /* across ranks: this rank's rows and columns only (the local diagonal block), and the
+     * couplings to other ranks' nodes (Ao) for the l1 term below */
+    if (!ierr && parallel) ierr = MatMPIAIJGetSeqAIJ(M, &M, &Ao, NULL);
     if (ierr) return ierr;
     int st = bsr_from_aij(M, &L->A);
     if (!st && L->A.n != L->n)
@@ -185,7 +215,8 @@ static PetscErrorCode shell_setup(PC pc)
         char what[40];
         snprintf(what, sizeof what, "petsc hierarchy level %d", L->level);
         bsr_diagonal(&L->A, L->diag);
-        st = block_diag_invert(L->n, L->diag, L->dinv, what);
+        if (Ao && L->l1) st = add_l1_term(Ao, L->n, L->diag);
+        if (!st) st = block_diag_invert(L->n, L->diag, L->dinv, what);
     }
     /* PETSc reports a user routine's failure by its code; the message is in mpm_last_error */
     return st ? PETSC_ERR_USER : 0;
@@ -403,6 +434,7 @@ int petsc_hierarchy_configure(PetscHierarchy *h, PC pc)
             st = pk(PCMGGetSmoother(pc, nl - 1 - k, &smoother), MPM_EINTERNAL, "PCMGGetSmoother");
             if (!st) st = pk(KSPSetType(smoother, KSPRICHARDSON), MPM_EINTERNAL, "KSPSetType(richardson)");
             if (!st) st = pk(KSPRichardsonSetScale(smoother, 1.0), MPM_EINTERNAL, "KSPRichardsonSetScale");
+            h->lev[k].l1 = h->comm != NULL; /* the coarse CG's Jacobi keeps the plain diagonal: CG converges anyway */
             if (!st) st = shell_pc(smoother, &h->lev[k], shell_sgs_apply, "mpmbench coloured symmetric block GS");
         }
     /* the coarsest level: block-Jacobi CG in the natural norm, to the

@@ -223,6 +223,20 @@ PY
   band_case sauce 1 --scene sauce --scale 4 --frames 6 --solver pn-pcg
   band_case snow 0 --scene snowball-drop --scale 4 --frames 16 --solver pn-pcg-mf
   band_case friction 0 --scene wheel --scale 6 --frames 1 --solver pn-pcg --eps 1e-10 --set colliders.1.type=slip --set colliders.1.friction=0.5
+  # HOT's per-rank Gauss-Seidel without the l1 term diverged on twist over 3
+  # ranks (10000 L-BFGS iterations, capped); with it the first frame
+  # converges in under twice one process's outer iterations (measured 124
+  # on one process, 209-219 on 2-4 ranks)
+  "$bin" run --scene twist --scale 4 --frames 1 --solver hot-petsc --threads 1 --quiet --out "$tmp/tw1" >"$tmp/out" 2>&1
+  rc=$?
+  check "twist with hot-petsc on one process: exit 0 ($(head -c 300 "$tmp/out"))" test $rc -eq 0
+  mpirun_ranks -np 3 "$bin" run --scene twist --scale 4 --frames 1 --solver hot-petsc --threads 1 --quiet --ranks 3 --max-step-seconds 60 --out "$tmp/tw3" >"$tmp/out" 2>&1
+  rc=$?
+  check "twist with hot-petsc on 3 ranks: exit 0 ($(head -c 300 "$tmp/out"))" test $rc -eq 0
+  check "twist with hot-petsc on 3 ranks: every step converged, outer iterations under twice one process's ($(python3 -c "import csv; print([(r['outer_iters'], r['status']) for r in csv.DictReader(open('$tmp/tw3/steps.csv'))])" 2>&1))" python3 -c "
+import csv, sys
+a = list(csv.DictReader(open('$tmp/tw1/steps.csv'))); b = list(csv.DictReader(open('$tmp/tw3/steps.csv')))
+sys.exit(not (len(a) == len(b) and all(y['status'] == 'converged' and int(y['outer_iters']) <= 2 * int(x['outer_iters']) for x, y in zip(a, b))))"
   check "sauce on 2 ranks: cut at its first emission (run.json recuts >= 1)" python3 -c "import json,sys; d=json.load(open('$tmp/sauce-2/run.json'))['distributed']; sys.exit(not (d['recuts'] >= 1 and min(d['particles_per_rank']) > 0))"
 fi
 # an error on one rank only: rank 0 alone makes the output folder; the
