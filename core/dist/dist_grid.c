@@ -3,25 +3,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/dist/node_pack.h"
 #include "core/error.h"
-
-#define KEY_BITS 21
-#define KEY_OFFSET (1 << (KEY_BITS - 1))
-#define KEY_MASK ((1ull << KEY_BITS) - 1)
-
-/* Node coordinates as one 64-bit item for the exchange, and back. */
-static uint64_t pack_node(const int c[3])
-{
-    return ((uint64_t)(c[0] + KEY_OFFSET) & KEY_MASK) << (2 * KEY_BITS) |
-           ((uint64_t)(c[1] + KEY_OFFSET) & KEY_MASK) << KEY_BITS | ((uint64_t)(c[2] + KEY_OFFSET) & KEY_MASK);
-}
-
-static void unpack_node(uint64_t k, int c[3])
-{
-    c[0] = (int)((k >> (2 * KEY_BITS)) & KEY_MASK) - KEY_OFFSET;
-    c[1] = (int)((k >> KEY_BITS) & KEY_MASK) - KEY_OFFSET;
-    c[2] = (int)(k & KEY_MASK) - KEY_OFFSET;
-}
 
 static int grow(DistGrid *dg, int nodes, int ghosts)
 {
@@ -68,7 +51,7 @@ int dist_grid_build(DistGrid *dg, const Decomposition *d, const CommOps *comm, G
         if (!ghost_key) status = mpm_error(MPM_EINTERNAL, "out of memory: %d ghost nodes", n_ghosts);
         for (int i = 0; !status && i < g->n; ++i) { /* offset[o]: the next free place of owner o */
             int o = decomposition_node_owner(d, g->coord + 3 * (size_t)i);
-            if (o != me) ghost_key[offset[o]++] = pack_node(g->coord + 3 * (size_t)i);
+            if (o != me) ghost_key[offset[o]++] = node_pack(g->coord + 3 * (size_t)i);
         }
     }
     if ((status = comm_agree(comm, status))) goto done;
@@ -82,7 +65,7 @@ int dist_grid_build(DistGrid *dg, const Decomposition *d, const CommOps *comm, G
     int n_extra = 0;
     for (int j = 0; !status && j < n_asked; ++j) {
         int c[3];
-        unpack_node(asked[j], c);
+        node_unpack(asked[j], c);
         if (decomposition_node_owner(d, c) != me)
             status = mpm_error(MPM_EINTERNAL, "rank %d asked for node (%d, %d, %d), which it does not own", me, c[0],
                                c[1], c[2]);
@@ -95,7 +78,7 @@ int dist_grid_build(DistGrid *dg, const Decomposition *d, const CommOps *comm, G
     if (!status && n_extra) status = grid_build_with_nodes(g, st, p, dx, extra, n_extra);
     for (int j = 0; !status && j < n_asked; ++j) {
         int c[3];
-        unpack_node(asked[j], c);
+        node_unpack(asked[j], c);
         answer[j] = (uint64_t)grid_lookup(g, c);
     }
     if ((status = comm_agree(comm, status))) goto done;
@@ -108,7 +91,7 @@ int dist_grid_build(DistGrid *dg, const Decomposition *d, const CommOps *comm, G
     for (int r = 0, j = 0; !status && r < R; ++r)
         for (int k = 0; k < back_counts[r]; ++k, ++j) {
             int c[3];
-            unpack_node(ghost_key[j], c);
+            node_unpack(ghost_key[j], c);
             dg->ghost_node[j] = grid_lookup(g, c);
             dg->owner_rank[j] = r;
             dg->owner_node[j] = (int)owner_ids[j];

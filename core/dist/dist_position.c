@@ -16,25 +16,9 @@
 #include <string.h>
 
 #include "core/dist/dist_sim.h"
+#include "core/dist/node_pack.h"
 #include "core/error.h"
 #include "core/position_update.h"
-
-#define RING_BITS 21
-#define RING_OFFSET (1 << (RING_BITS - 1))
-#define RING_MASK ((1ull << RING_BITS) - 1)
-
-static uint64_t pack_node(const int c[3])
-{
-    return ((uint64_t)(c[0] + RING_OFFSET) & RING_MASK) << (2 * RING_BITS) |
-           ((uint64_t)(c[1] + RING_OFFSET) & RING_MASK) << RING_BITS | ((uint64_t)(c[2] + RING_OFFSET) & RING_MASK);
-}
-
-static void unpack_node(uint64_t k, int c[3])
-{
-    c[0] = (int)((k >> (2 * RING_BITS)) & RING_MASK) - RING_OFFSET;
-    c[1] = (int)((k >> RING_BITS) & RING_MASK) - RING_OFFSET;
-    c[2] = (int)(k & RING_MASK) - RING_OFFSET;
-}
 
 typedef struct {
     uint64_t key;
@@ -74,7 +58,7 @@ static int ring_nodes(const Grid *g, const Decomposition *d, int me, uint64_t **
                 key = k;
                 cap *= 2;
             }
-            key[n++] = pack_node(q);
+            key[n++] = node_pack(q);
         }
     }
     qsort(key, (size_t)n, sizeof *key, by_value);
@@ -110,13 +94,13 @@ int dist_backward_euler(Simulation *sim)
         st = mpm_error(MPM_EINTERNAL, "out of memory: %d ring nodes", n_ring);
     for (int j = 0; !st && j < n_ring; ++j) {
         int q[3];
-        unpack_node(ring[j], q);
+        node_unpack(ring[j], q);
         send_counts[decomposition_node_owner(&sim->decomp, q)]++;
     }
     for (int r = 0; !st && r < R; ++r) at[r + 1] = at[r] + send_counts[r];
     for (int j = 0; !st && j < n_ring; ++j) {
         int q[3];
-        unpack_node(ring[j], q);
+        node_unpack(ring[j], q);
         ask[at[decomposition_node_owner(&sim->decomp, q)]++] = ring[j];
     }
     if ((st = comm_agree(c, st))) goto done;
@@ -127,7 +111,7 @@ int dist_backward_euler(Simulation *sim)
         st = mpm_error(MPM_EINTERNAL, "out of memory: %d asked nodes", n_asked);
     for (int j = 0; !st && j < n_asked; ++j) {
         int q[3];
-        unpack_node(asked[j], q);
+        node_unpack(asked[j], q);
         const int id = grid_lookup(g, q);
         const double zero[3] = {0, 0, 0};
         answer[4 * j] = id >= 0;
@@ -142,7 +126,7 @@ int dist_backward_euler(Simulation *sim)
     if (!found || !remote) st = mpm_error(MPM_EINTERNAL, "out of memory: %d ring nodes", n_ring);
     for (int j = 0; !st && j < n_ring; ++j)
         if (got[4 * j]) {
-            unpack_node(ask[j], found + 3 * (size_t)n_found);
+            node_unpack(ask[j], found + 3 * (size_t)n_found);
             remote[n_found].key = ask[j];
             memcpy(remote[n_found++].v, got + 4 * j + 1, 3 * sizeof(double));
         }
@@ -154,7 +138,7 @@ int dist_backward_euler(Simulation *sim)
     for (int i = 0; !st && i < ext.n; ++i) {
         const int *q = ext.coord + 3 * (size_t)i;
         const int id = grid_lookup(g, q);
-        const RemoteNode probe = {pack_node(q), {0, 0, 0}};
+        const RemoteNode probe = {node_pack(q), {0, 0, 0}};
         const RemoteNode *hit = id >= 0 ? NULL : bsearch(&probe, remote, (size_t)n_found, sizeof *remote, by_key);
         if (id >= 0) memcpy(v + 3 * (size_t)i, sim->vnew + 3 * (size_t)id, 3 * sizeof(double));
         else if (hit) memcpy(v + 3 * (size_t)i, hit->v, 3 * sizeof(double));

@@ -6,25 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/dist/node_pack.h"
 #include "core/error.h"
 #include "core/node_order.h"
-
-enum { COORD_BITS = 21 };
-static const int64_t COORD_OFFSET = (int64_t)1 << (COORD_BITS - 1);
-
-/* coordinates as one 64-bit item of an exchange (21 bits an axis) */
-static uint64_t pack_coord(const int c[3])
-{
-    uint64_t v = 0;
-    for (int a = 0; a < 3; ++a) v = (v << COORD_BITS) | (uint64_t)((int64_t)c[a] + COORD_OFFSET);
-    return v;
-}
-
-static void unpack_coord(uint64_t v, int c[3])
-{
-    const uint64_t mask = ((uint64_t)1 << COORD_BITS) - 1;
-    for (int a = 2; a >= 0; --a, v >>= COORD_BITS) c[a] = (int)((int64_t)(v & mask) - COORD_OFFSET);
-}
 
 typedef struct {
     uint64_t key, packed;
@@ -80,7 +64,7 @@ int mg_coarse_ranks(const CommOps *comm, const Decomposition *d, int level, cons
         const int *c = T->coarse_coord + 3 * (size_t)k;
         int pos[3];
         for (int a = 0; a < 3; ++a) {
-            if (c[a] >= COORD_OFFSET || c[a] < -COORD_OFFSET)
+            if (c[a] >= NODE_PACK_OFFSET || c[a] < -NODE_PACK_OFFSET)
                 st = mpm_error(MPM_EINTERNAL, "coarse node coordinate %d outside +-2^20", c[a]);
             pos[a] = c[a] * (1 << level);
         }
@@ -97,7 +81,7 @@ int mg_coarse_ranks(const CommOps *comm, const Decomposition *d, int level, cons
             slot[k] = -1;
             if (owner[k] == me) continue;
             slot[k] = next[owner[k]]++;
-            send[slot[k]] = pack_coord(T->coarse_coord + 3 * (size_t)k);
+            send[slot[k]] = node_pack(T->coarse_coord + 3 * (size_t)k);
         }
     }
     if ((st = comm_agree(comm, st))) goto done;
@@ -113,12 +97,12 @@ int mg_coarse_ranks(const CommOps *comm, const Decomposition *d, int level, cons
     if (!list || !reply) st = mpm_error(MPM_EINTERNAL, "out of memory: coarse level over ranks (%d asked)", n_recv);
     for (int k = 0; k < m && !st; ++k)
         if (owner[k] == me) {
-            list[n_list].packed = pack_coord(T->coarse_coord + 3 * (size_t)k);
+            list[n_list].packed = node_pack(T->coarse_coord + 3 * (size_t)k);
             list[n_list++].key = node_order_key(T->coarse_coord + 3 * (size_t)k);
         }
     for (int q = 0; q < n_recv && !st; ++q) {
         int c[3];
-        unpack_coord(recv[q], c);
+        node_unpack(recv[q], c);
         list[n_list].packed = recv[q];
         list[n_list++].key = node_order_key(c);
     }
@@ -142,12 +126,12 @@ int mg_coarse_ranks(const CommOps *comm, const Decomposition *d, int level, cons
     out->n_owned = n_owned;
     out->first = (int)first;
     out->total = (int)total;
-    for (int q = 0; q < n_owned && !st; ++q) unpack_coord(list[q].packed, out->owned_coord + 3 * (size_t)q);
+    for (int q = 0; q < n_owned && !st; ++q) node_unpack(list[q].packed, out->owned_coord + 3 * (size_t)q);
     for (int k = 0; k < m && !st; ++k)
         if (owner[k] == me) out->global[k] = out->first + find_key(list, n_owned, node_order_key(T->coarse_coord + 3 * (size_t)k));
     for (int q = 0; q < n_recv && !st; ++q) {
         int c[3];
-        unpack_coord(recv[q], c);
+        node_unpack(recv[q], c);
         reply[q] = (uint64_t)(out->first + find_key(list, n_owned, node_order_key(c)));
     }
     if ((st = comm_agree(comm, st))) goto done;
