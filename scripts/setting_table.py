@@ -75,6 +75,10 @@ def repeated(d, cells, axis):
     runs = {}
     for r in cells:
         runs.setdefault((r["scene"], r["solver"], r["threads"], r[axis]), []).append(r)
+    # each solver is judged against the first setting it ran: a matrix may
+    # pair settings with solvers by exclude rules (one library's options
+    # with its own solvers), so "first" is per solver
+    own = {sv: [st for st in settings if any(r["solver"] == sv and r[axis] == st for r in cells)] for sv in solvers}
 
     def quiet_ok(r):
         return ok(r) and r.get("machine_busy", "0") != "1"
@@ -94,7 +98,7 @@ def repeated(d, cells, axis):
         t = [float(x["s_per_frame"]) for x in good]
         m = median(t) if t else float("nan")
         med[(scene, solver, setting)] = m if not bad else float("nan")
-        first = med.get((scene, solver, settings[0]), float("nan"))
+        first = med.get((scene, solver, own[solver][0]), float("nan"))
         ratio = m / first if not bad and first == first and first > 0 else float("nan")
         status = "converged" if not bad else (r["worst_solve_status"] or r["status"])
         if any(x.get("machine_busy", "0") == "1" for x in rows):
@@ -111,11 +115,12 @@ def repeated(d, cells, axis):
         print(f"| solver | {axis} | converged on every scene | faster on every scene | geo. mean of the ratios | wins |")
         print("|---|---|---|---|---:|---|")
         best = None
-        for setting in settings[1:]:
+        first = own[solver][0]
+        for setting in own[solver][1:]:
             conv = all(not failed.get((sc, solver, setting), True) for sc in scenes)
             ratios, faster = [], conv
             for sc in scenes:
-                a, b = med.get((sc, solver, setting), float("nan")), med.get((sc, solver, settings[0]), float("nan"))
+                a, b = med.get((sc, solver, setting), float("nan")), med.get((sc, solver, first), float("nan"))
                 if b == b and a == a:
                     ratios.append(a / b)
                     faster = faster and a < b
@@ -127,7 +132,7 @@ def repeated(d, cells, axis):
                   f"{'-' if g != g else f'{g:.2f}'} | {'yes' if wins else 'no'} |")
         print()
         print(f"{solver}: " + (f"adopt {axis} {best[0]} (geometric mean {best[1]:.2f} of the first's time)."
-                               if best else f"keep the first {axis} ({settings[0]})."))
+                               if best else f"keep the first {axis} ({first})."))
         print()
 
 
