@@ -474,6 +474,37 @@ def is_petsc_amg(solver):
     return solver in GAMG or ":petsc:pc_type=" in solver
 
 
+# the out-of-sample tuning's solvers (the adapters' specs) and the presets they set
+ALGT_FORMS = {"pn-amg": "pn:boomeramg:reuse_every=0", "lbfgs-amg": "lbfgs:boomeramg",
+              "pn-ml": "pn:ml:reuse_every=0", "lbfgs-ml": "lbfgs:ml"}
+
+
+def algt_adopted(form, what):
+    """results/algebraic-tuning: the setting its adoption rule took for one
+    solver form (setting_table.adoption) and its geometric-mean ratio to
+    the untuned default ("setting", "ratio"), or the count of settings that
+    qualified ("winners")."""
+    import setting_table
+    cells = [r for r in table("algebraic-tuning", "cells.csv") if r.get("role", "") != "reference"]
+    decided = setting_table.adoption(cells, "variant")
+    if ALGT_FORMS[form] not in decided:
+        raise Missing(f"results/algebraic-tuning: no cells of {ALGT_FORMS[form]}")
+    a = decided[ALGT_FORMS[form]]
+    if what == "winners":
+        return str(sum(1 for j in a["judged"] if j[4]))
+    if what == "setting":
+        return a["best"][0] if a["best"] else f"none (kept {a['first']})"
+    if not a["best"]:
+        raise Missing(f"results/algebraic-tuning: nothing adopted for {ALGT_FORMS[form]}")
+    return sig(a["best"][1], 2)
+
+
+def bos_lead(threads, what="geo"):
+    """results/baselines-out-of-sample: per scene the fastest algebraic
+    multigrid's median s/frame over HOT's (median_lead)."""
+    return median_lead("baselines-out-of-sample", lambda so: so in ALGEBRAIC, what, threads)
+
+
 def fig18_speedup(scene, solver="gast15"):
     return sig(num(one("gast15-fig18", scene=scene, solver=solver), "speedup_total"))
 
@@ -669,6 +700,18 @@ NUMBERS = {
     "pb.ml_lead_2t": lambda: petsc_baselines_over_hot(lambda so: so == "lbfgs-ml"),
     "pb.hot_petsc_over_hot": lambda: petsc_baselines_over_hot(lambda so: so == "hot-petsc"),
     "pb.hot_petsc_over_hot_range": lambda: petsc_baselines_over_hot(lambda so: so == "hot-petsc", "range"),
+    "algt.date": lambda: run_date("algebraic-tuning"),
+    "algt.cells": lambda: cells_ok("algebraic-tuning"),
+    **{f"algt.{form}_adopted": (lambda form=form: algt_adopted(form, "setting")) for form in ALGT_FORMS},
+    **{f"algt.{form}_over_untuned": (lambda form=form: algt_adopted(form, "ratio")) for form in ALGT_FORMS},
+    **{f"algt.{form}_winners": (lambda form=form: algt_adopted(form, "winners")) for form in ALGT_FORMS},
+    "bos.date": lambda: run_date("baselines-out-of-sample"),
+    "bos.cells": lambda: cells_ok("baselines-out-of-sample"),
+    "bos.lead_2t": lambda: bos_lead(2),
+    "bos.lead_2t_range": lambda: bos_lead(2, "range"),
+    "bos.lead_2t_n": lambda: bos_lead(2, "n"),
+    "bos.lead_1t": lambda: bos_lead(1),
+    "bos.lead_1t_range": lambda: bos_lead(1, "range"),
     "paper.cells": lambda: cells_ok("paper-scale"),
     "paper.date": lambda: run_date("paper-scale"),
     "paper.n_scenes": lambda: str(len(paper_scenes())),

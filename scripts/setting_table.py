@@ -60,63 +60,45 @@ def median(v):
     return v[len(v) // 2] if len(v) % 2 else (v[len(v) // 2 - 1] + v[len(v) // 2]) / 2
 
 
-def repeated(d, cells, axis):
-    """A tuning run with repeats: per scene and solver form, each setting's
-    median s/frame over its converged runs on a quiet machine, the spread,
-    the ratio to the first setting's median, the iterations of the median
-    run; then the adoption rule of the tuning matrices (written in their
-    descriptions): a setting beats the first one for a solver when it
-    converged in every run of every scene and its median is lower on every
-    scene where the first converged (a scene the first failed counts as a
-    win); of the winners, the lowest geometric mean of the ratios."""
+def quiet_ok(r):
+    return ok(r) and r.get("machine_busy", "0") != "1"
+
+
+def medians(cells, axis):
+    """Per (scene, solver, threads, setting): its runs; per (scene, solver,
+    setting): the median s/frame of the converged runs on a quiet machine
+    (NaN when any run failed) and whether a run failed; per solver the
+    settings it ran in the matrix's order (each solver is judged against
+    the first setting it ran: a matrix may pair settings with solvers by
+    exclude rules, one library's options with its own solvers)."""
     settings = list(dict.fromkeys(r[axis] for r in cells))
-    scenes = list(dict.fromkeys(r["scene"] for r in cells))
     solvers = list(dict.fromkeys(r["solver"] for r in cells))
-    runs = {}
+    runs, med, failed = {}, {}, {}
     for r in cells:
         runs.setdefault((r["scene"], r["solver"], r["threads"], r[axis]), []).append(r)
-    # each solver is judged against the first setting it ran: a matrix may
-    # pair settings with solvers by exclude rules (one library's options
-    # with its own solvers), so "first" is per solver
+    for (scene, solver, _, setting), rows in runs.items():
+        bad = any(not ok(r) for r in rows)
+        t = [float(r["s_per_frame"]) for r in rows if quiet_ok(r)]
+        failed[(scene, solver, setting)] = bad
+        med[(scene, solver, setting)] = median(t) if t and not bad else float("nan")
     own = {sv: [st for st in settings if any(r["solver"] == sv and r[axis] == st for r in cells)] for sv in solvers}
+    return runs, med, failed, own
 
-    def quiet_ok(r):
-        return ok(r) and r.get("machine_busy", "0") != "1"
 
-    print(f"| scene | solver | threads | {axis} | runs | s/frame: median (spread) | / first | outer | linear |"
-          " setup share | op. complexity | status |")
-    print("|---|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|")
-    med = {}
-    failed = {}
-    for (scene, solver, threads, setting), rows in sorted(
-            runs.items(), key=lambda kv: (scenes.index(kv[0][0]), solvers.index(kv[0][1]), kv[0][2],
-                                          settings.index(kv[0][3]))):
-        good = sorted((r for r in rows if quiet_ok(r)), key=lambda r: float(r["s_per_frame"]))
-        bad = [r for r in rows if not ok(r)]
-        failed[(scene, solver, setting)] = bool(bad)
-        r = good[(len(good) - 1) // 2] if good else rows[0]
-        t = [float(x["s_per_frame"]) for x in good]
-        m = median(t) if t else float("nan")
-        med[(scene, solver, setting)] = m if not bad else float("nan")
-        first = med.get((scene, solver, own[solver][0]), float("nan"))
-        ratio = m / first if not bad and first == first and first > 0 else float("nan")
-        status = "converged" if not bad else (r["worst_solve_status"] or r["status"])
-        if any(x.get("machine_busy", "0") == "1" for x in rows):
-            status += " (a run on a busy machine, left out)"
-        spread = f" ({(max(t) - min(t)) / m:.0%})" if t else ""
-        print(f"| {scene} | {solver} | {threads} | {setting} | {len(rows)} | "
-              f"{'-' if m != m or bad else f'{m:.3g}{spread}'} | {'-' if ratio != ratio else f'{ratio:.2f}'} | "
-              f"{r['outer_iters']} | {r['linear_iters']} | {share(d, r)} | {counters(d, r)[1]} | {status} |")
-    print()
-    print("Adoption rule (a setting wins when it converged on every scene and its median is below the first "
-          f"{axis}'s on every scene the first converged on):")
-    print()
-    for solver in solvers:
-        print(f"| solver | {axis} | converged on every scene | faster on every scene | geo. mean of the ratios | wins |")
-        print("|---|---|---|---|---:|---|")
-        best = None
-        first = own[solver][0]
-        for setting in own[solver][1:]:
+def adoption(cells, axis):
+    """The adoption rule of the tuning matrices (written in their
+    descriptions), per solver: a setting beats the solver's first one when it
+    converged in every run of every scene and its median is lower on every
+    scene where the first converged (a scene the first failed counts as a
+    win); of the winners, the lowest geometric mean of the ratios.
+    {solver: {"first": setting, "judged": [(setting, converged, faster,
+    geo_mean, wins)], "best": (setting, geo_mean) or None}}"""
+    scenes = list(dict.fromkeys(r["scene"] for r in cells))
+    _, med, failed, own = medians(cells, axis)
+    out = {}
+    for solver, mine in own.items():
+        first, judged, best = mine[0], [], None
+        for setting in mine[1:]:
             conv = all(not failed.get((sc, solver, setting), True) for sc in scenes)
             ratios, faster = [], conv
             for sc in scenes:
@@ -128,11 +110,56 @@ def repeated(d, cells, axis):
             wins = conv and faster
             if wins and (best is None or g < best[1]):
                 best = (setting, g)
+            judged.append((setting, conv, faster, g, wins))
+        out[solver] = {"first": first, "judged": judged, "best": best}
+    return out
+
+
+def repeated(d, cells, axis):
+    """A tuning run with repeats: per scene and solver form, each setting's
+    median s/frame over its converged runs on a quiet machine, the spread,
+    the ratio to the solver's first setting's median, the iterations of the
+    median run; then the adoption rule (adoption())."""
+    settings = list(dict.fromkeys(r[axis] for r in cells))
+    scenes = list(dict.fromkeys(r["scene"] for r in cells))
+    solvers = list(dict.fromkeys(r["solver"] for r in cells))
+    runs, med, failed, own = medians(cells, axis)
+    print(f"| scene | solver | threads | {axis} | runs | s/frame: median (spread) | / first | outer | linear |"
+          " setup share | op. complexity | status |")
+    print("|---|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|")
+    for (scene, solver, threads, setting), rows in sorted(
+            runs.items(), key=lambda kv: (scenes.index(kv[0][0]), solvers.index(kv[0][1]), kv[0][2],
+                                          settings.index(kv[0][3]))):
+        good = sorted((r for r in rows if quiet_ok(r)), key=lambda r: float(r["s_per_frame"]))
+        bad = failed[(scene, solver, setting)]
+        r = good[(len(good) - 1) // 2] if good else rows[0]
+        t = [float(x["s_per_frame"]) for x in good]
+        m = med[(scene, solver, setting)]
+        first = med.get((scene, solver, own[solver][0]), float("nan"))
+        ratio = m / first if not bad and first == first and first > 0 else float("nan")
+        status = "converged" if not bad else (r["worst_solve_status"] or r["status"])
+        if not bad and not good:
+            status = "no run on a quiet machine"
+        if any(x.get("machine_busy", "0") == "1" for x in rows):
+            status += " (a run on a busy machine, left out)"
+        spread = f" ({(max(t) - min(t)) / m:.0%})" if t and m == m else ""
+        print(f"| {scene} | {solver} | {threads} | {setting} | {len(rows)} | "
+              f"{'-' if m != m else f'{m:.3g}{spread}'} | {'-' if ratio != ratio else f'{ratio:.2f}'} | "
+              f"{r['outer_iters']} | {r['linear_iters']} | {share(d, r)} | {counters(d, r)[1]} | {status} |")
+    print()
+    print("Adoption rule (a setting wins when it converged on every scene and its median is below the first "
+          f"{axis}'s on every scene the first converged on):")
+    print()
+    for solver, a in adoption(cells, axis).items():
+        print(f"| solver | {axis} | converged on every scene | faster on every scene | geo. mean of the ratios | wins |")
+        print("|---|---|---|---|---:|---|")
+        for setting, conv, faster, g, wins in a["judged"]:
             print(f"| {solver} | {setting} | {'yes' if conv else 'no'} | {'yes' if faster else 'no'} | "
                   f"{'-' if g != g else f'{g:.2f}'} | {'yes' if wins else 'no'} |")
+        best = a["best"]
         print()
         print(f"{solver}: " + (f"adopt {axis} {best[0]} (geometric mean {best[1]:.2f} of the first's time)."
-                               if best else f"keep the first {axis} ({first})."))
+                               if best else f"keep the first {axis} ({a['first']})."))
         print()
 
 

@@ -45,4 +45,39 @@ check "pn-b's ratios are to b-untuned" grep -qE "^\| s2 \| pn-b \| 2 \| b-better
 check "pn-b's rule lists only its own settings" \
   test "$(grep -cE '^\| pn-b \| a-' "$tmp/table.md")" -eq 0
 check "a-fastest does not win (a run failed on s2)" grep -qE "^\| lbfgs-a \| a-fastest \| no \|" "$tmp/table.md"
+
+# The algebraic presets are what the committed out-of-sample tuning
+# (results/algebraic-tuning) adopted: each preset's definition equals its
+# base spec with the adopted variant's options (or none), by this build.
+if "$bin" list definitions --solver pn-amg-pcg --solver pn-ml-pcg >/dev/null 2>&1; then
+  python3 - "$src" "$bin" <<'PY' >"$tmp/presets.txt" 2>&1
+import csv, json, os, subprocess, sys
+src, binary = sys.argv[1], sys.argv[2]
+sys.path.insert(0, os.path.join(src, "scripts"))
+import setting_table
+d = os.path.join(src, "results", "algebraic-tuning")
+cells = [r for r in csv.DictReader(open(os.path.join(d, "cells.csv"))) if r.get("role", "") != "reference"]
+variants = {v["label"]: v["settings"] for a in json.load(open(os.path.join(d, "matrix.json")))["named_axes"]
+            if a["name"] == "variant" for v in a["values"]}
+decided = setting_table.adoption(cells, "variant")
+presets = {"pn:boomeramg:reuse_every=0": "pn-amg-pcg", "lbfgs:boomeramg": "lbfgs-amg",
+           "pn:ml:reuse_every=0": "pn-ml-pcg", "lbfgs:ml": "lbfgs-ml"}
+def definition_hash(spec):
+    out = subprocess.run([binary, "list", "definitions", "--solver", spec], capture_output=True, text=True, check=True)
+    return out.stdout.split()[1]
+bad = 0
+for base, preset in presets.items():
+    a = decided[base]
+    setting = a["best"][0] if a["best"] else a["first"]
+    opts = variants[setting]
+    spec = base + ("," if base.count(":") == 2 else ":") + ",".join(f"{k}={v}" for k, v in opts.items())
+    same = definition_hash(spec) == definition_hash(preset)
+    bad += not same
+    print(f"{preset}: adopted {setting} -> {spec}: {'same' if same else 'DIFFERENT'} definition")
+print("ok" if not bad else "presets differ from the adoption")
+PY
+  rc=$?
+  check "the algebraic presets are the adopted settings ($(tr '\n' ';' <"$tmp/presets.txt"))" \
+    bash -c "test $rc -eq 0 && tail -1 '$tmp/presets.txt' | grep -qx ok"
+fi
 finish
