@@ -54,6 +54,7 @@ import statistics
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import setting_table  # noqa: E402
 import study_status  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -474,17 +475,14 @@ def is_petsc_amg(solver):
     return solver in GAMG or ":petsc:pc_type=" in solver
 
 
-# the out-of-sample tuning's solvers (the adapters' specs) and the presets they set
-ALGT_FORMS = {"pn-amg": "pn:boomeramg:reuse_every=0", "lbfgs-amg": "lbfgs:boomeramg",
-              "pn-ml": "pn:ml:reuse_every=0", "lbfgs-ml": "lbfgs:ml"}
+ALGT_FORMS = setting_table.TUNED_PRESETS  # preset -> the spec its out-of-sample tuning ran
 
 
 def algt_adopted(form, what):
     """results/algebraic-tuning: the setting its adoption rule took for one
-    solver form (setting_table.adoption) and its geometric-mean ratio to
+    preset's solver form (setting_table.adoption) and its geometric-mean ratio to
     the untuned default ("setting", "ratio"), or the count of settings that
     qualified ("winners")."""
-    import setting_table
     cells = [r for r in table("algebraic-tuning", "cells.csv") if r.get("role", "") != "reference"]
     decided = setting_table.adoption(cells, "variant")
     if ALGT_FORMS[form] not in decided:

@@ -21,6 +21,13 @@ import os
 import sys
 
 
+# the algebraic presets the out-of-sample tuning (results/algebraic-tuning)
+# sets, and the adapter spec its cells ran for each: a preset is its spec
+# plus the options of the setting adopted there
+TUNED_PRESETS = {"pn-amg-pcg": "pn:boomeramg:reuse_every=0", "lbfgs-amg": "lbfgs:boomeramg",
+                 "pn-ml-pcg": "pn:ml:reuse_every=0", "lbfgs-ml": "lbfgs:ml"}
+
+
 def read_csv(path):
     if not os.path.exists(path):
         return []

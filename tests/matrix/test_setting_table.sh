@@ -60,13 +60,11 @@ cells = [r for r in csv.DictReader(open(os.path.join(d, "cells.csv"))) if r.get(
 variants = {v["label"]: v["settings"] for a in json.load(open(os.path.join(d, "matrix.json")))["named_axes"]
             if a["name"] == "variant" for v in a["values"]}
 decided = setting_table.adoption(cells, "variant")
-presets = {"pn:boomeramg:reuse_every=0": "pn-amg-pcg", "lbfgs:boomeramg": "lbfgs-amg",
-           "pn:ml:reuse_every=0": "pn-ml-pcg", "lbfgs:ml": "lbfgs-ml"}
 def definition_hash(spec):
     out = subprocess.run([binary, "list", "definitions", "--solver", spec], capture_output=True, text=True, check=True)
     return out.stdout.split()[1]
 bad = 0
-for base, preset in presets.items():
+for preset, base in setting_table.TUNED_PRESETS.items():
     a = decided[base]
     setting = a["best"][0] if a["best"] else a["first"]
     opts = variants[setting]
