@@ -24,28 +24,32 @@ printf 'x <!-- n:no.such.key -->1<!-- /n --> y\n' >"$tmp/unknown.md"
 check "an unknown key fails" bash -c "! python3 '$fill' --check '$tmp/unknown.md' 2>/dev/null"
 
 # --- trust ---
-# scenes-bench is stale for this build (its status line says so)
-stale_val=$(python3 "$fill" --list | sed -n 's/^scenes.hot_geomean: \([^ ]*\) .*/\1/p')
-check "scenes.hot_geomean has a value ($stale_val)" test -n "$stale_val"
-printf '# A\n\nx <!-- n:scenes.hot_geomean -->%s<!-- /n --> y\n' "$stale_val" >"$tmp/n-stale.md"
+# stiffness is stale for this build (its status line says so)
+stale_val=$(python3 "$fill" --list | sed -n 's/^stiffness.hot_geomean: \([^ ]*\) .*/\1/p')
+check "stiffness.hot_geomean has a value ($stale_val)" test -n "$stale_val"
+printf '# A\n\nx <!-- n:stiffness.hot_geomean -->%s<!-- /n --> y\n' "$stale_val" >"$tmp/n-stale.md"
 python3 "$fill" --check "$tmp/n-stale.md" 2>"$tmp/n-stale.err"
 check "a stale study's number quoted as current fails" test $? -ne 0
 check "... saying to quote it as history" grep -q "not a current number.*quote it as history" "$tmp/n-stale.err"
-printf '# A\n\nx <!-- h:scenes.hot_geomean -->%s<!-- /n --> y\n' "$stale_val" >"$tmp/h-bare.md"
+printf '# A\n\nx <!-- h:stiffness.hot_geomean -->%s<!-- /n --> y\n' "$stale_val" >"$tmp/h-bare.md"
 python3 "$fill" --check "$tmp/h-bare.md" 2>"$tmp/h-bare.err"
 check "history without its study's status in the section fails" test $? -ne 0
-check "... naming the status marker" grep -q "s:scenes-bench -->) is not in its section" "$tmp/h-bare.err"
-st=$(python3 -c "import sys; sys.path.insert(0, '$src/scripts'); import fill_numbers as f; print(f.status_text('scenes-bench'))")
-check "the status line names build, runs and staleness ($st)" bash -c "echo '$st' | grep -q 'scenes-bench: build [0-9a-f]\{7\}.*1 run per cell.*stale for .*kept for history'"
-printf '# A\n\nx <!-- h:scenes.hot_geomean -->%s<!-- /n --> y\n\n## B\n\n- <!-- s:scenes-bench -->%s<!-- /n -->\n\n# C\n' "$stale_val" "$st" >"$tmp/h-ok.md"
+check "... naming the status marker" grep -q "s:stiffness -->) is not in its section" "$tmp/h-bare.err"
+st=$(python3 -c "import sys; sys.path.insert(0, '$src/scripts'); import fill_numbers as f; print(f.status_text('stiffness'))")
+check "the status line names build, runs and staleness ($st)" bash -c "echo '$st' | grep -q 'stiffness: build [0-9a-f]\{7\}.*1 run per cell.*stale for .*kept for history'"
+printf '# A\n\nx <!-- h:stiffness.hot_geomean -->%s<!-- /n --> y\n\n## B\n\n- <!-- s:stiffness -->%s<!-- /n -->\n\n# C\n' "$stale_val" "$st" >"$tmp/h-ok.md"
 check "history with its study's status in its section (a subsection) passes" python3 "$fill" --check "$tmp/h-ok.md"
-printf '# A\n\nx <!-- h:scenes.hot_geomean -->%s<!-- /n --> y\n\n# B\n\n- <!-- s:scenes-bench -->%s<!-- /n -->\n' "$stale_val" "$st" >"$tmp/h-far.md"
+printf '# A\n\nx <!-- h:stiffness.hot_geomean -->%s<!-- /n --> y\n\n# B\n\n- <!-- s:stiffness -->%s<!-- /n -->\n' "$stale_val" "$st" >"$tmp/h-far.md"
 check "the status in another section does not count" bash -c "! python3 '$fill' --check '$tmp/h-far.md' 2>/dev/null"
-printf '# A\n\n- <!-- s:scenes-bench -->build 1<!-- /n -->\n' >"$tmp/s-typed.md"
+printf '# A\n\n- <!-- s:stiffness -->build 1<!-- /n -->\n' >"$tmp/s-typed.md"
 check "a status typed by hand fails" bash -c "! python3 '$fill' --check '$tmp/s-typed.md' 2>/dev/null"
-date_val=$(python3 "$fill" --list | sed -n 's/^scenes.date: //p')
-printf '# A\n\n<!-- h:scenes.date -->%s<!-- /n -->\n\n- <!-- s:scenes-bench -->%s<!-- /n -->\n' "$date_val" "$st" >"$tmp/h-current.md"
+date_val=$(python3 "$fill" --list | sed -n 's/^stiffness.date: //p')
+printf '# A\n\n<!-- h:stiffness.date -->%s<!-- /n -->\n\n- <!-- s:stiffness -->%s<!-- /n -->\n' "$date_val" "$st" >"$tmp/h-current.md"
 check "a study's date quoted as history fails (it describes, it is current)" bash -c "! python3 '$fill' --check '$tmp/h-current.md' 2>/dev/null"
+# scenes-bench is current (this build's definitions, 3 runs a cell, quiet): its ranking quoted as current passes
+cur_val=$(python3 "$fill" --list | sed -n 's/^scenes.hot_geomean: \([^ ]*\).*/\1/p')
+printf '# A\n\nx <!-- n:scenes.hot_geomean -->%s<!-- /n --> y\n' "$cur_val" >"$tmp/n-current.md"
+check "a current study's ranking quoted as current passes ($cur_val)" python3 "$fill" --check "$tmp/n-current.md"
 # the rules themselves, on made-up statuses: current, busy, one run
 python3 - "$src/scripts" <<'PY' >"$tmp/rules.out" 2>&1
 import sys
@@ -61,10 +65,15 @@ assert f.doubts(rank, {"good", "stale"}), "one stale study is enough"
 assert f.doubts(plain, {"busy"}), "busy cells"
 assert f.doubts(rank, {"once"}) and not f.doubts(plain, {"once"}), "one run: refused for a ranking only"
 assert f.doubts("scenes.date", {"stale"}) == [], "a date describes the study"
+row = lambda t, lo, hi, n: {"s_per_frame": t, "s_per_frame_min": lo, "s_per_frame_max": hi, "runs": n}
+assert f.clearly_faster(row(1.0, 0.9, 1.1, 3), row(1.5, 1.2, 1.6, 3)), "ranges apart: faster"
+assert not f.clearly_faster(row(1.0, 0.9, 1.3, 3), row(1.5, 1.2, 1.6, 3)), "ranges overlap: a tie, whatever the medians"
+assert not f.clearly_faster(row(1.0, 1.0, 1.0, 1), row(1.05, 1.05, 1.05, 1)), "single runs: within the 1.1x floor"
+assert f.clearly_faster(row(1.0, 1.0, 1.0, 1), row(1.2, 1.2, 1.2, 1)), "single runs: beyond it"
 print("rules ok")
 PY
 check "trust rules on made-up statuses ($(tail -1 "$tmp/rules.out"))" grep -qx "rules ok" "$tmp/rules.out"
 # a stale study's page says so on its first line
-page="$src/results/scenes-bench/report.md"
-check "scenes-bench's page opens with its status" bash -c "head -1 '$page' | grep -q '^> <!-- s:scenes-bench -->'"
+page="$src/results/stiffness/report.md"
+check "stiffness's page opens with its status" bash -c "head -1 '$page' | grep -q '^> <!-- s:stiffness -->'"
 finish
