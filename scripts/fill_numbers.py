@@ -52,11 +52,12 @@ import os
 import re
 import statistics
 import sys
+import types
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import setting_table  # noqa: E402
 import study_status  # noqa: E402
-from matrix_report import NOISE_FLOOR  # noqa: E402  (closer single runs are not ranked)
+import matrix_report  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RESULTS = os.path.join(ROOT, "results")
@@ -257,13 +258,14 @@ def stiffness_iters(solver):
 
 
 def clearly_faster(a, b):
-    """Report row a's s/frame is below row b's by more than the noise, by the
-    rule the report ranks with (matrix_report.clearly_faster): with repeats
-    the min-max ranges of the runs do not overlap, else by more than its
-    1.1x noise floor."""
-    if num(a, "runs") > 1 or num(b, "runs") > 1:
-        return num(a, "s_per_frame_max") < num(b, "s_per_frame_min")
-    return num(b, "s_per_frame") > NOISE_FLOOR * num(a, "s_per_frame")
+    """Report row a's s/frame is below row b's by more than the noise: the
+    report's own rule (matrix_report.clearly_faster: with repeats the min-max
+    ranges of the runs do not overlap, else more than its 1.1x floor), on
+    report.csv rows."""
+    def cell(r):
+        return types.SimpleNamespace(runs=range(int(num(r, "runs"))), lo=num(r, "s_per_frame_min"),
+                                     hi=num(r, "s_per_frame_max"), s_per_frame=num(r, "s_per_frame"))
+    return matrix_report.clearly_faster(cell(a), cell(b))
 
 
 def scenes_hot_not_fastest(what="list"):
