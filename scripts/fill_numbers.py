@@ -3,7 +3,7 @@
 
 Markdown files carry markers around every number taken from a study:
 
-    HOT is the fastest on <!-- n:scenes.hot_fastest -->10 of 13<!-- /n --> scenes
+    HOT is the fastest on <!-- n:scenes.hot_fastest_summary -->7 of 13<!-- /n --> scenes
 
 The key after "n:" names a function below, which computes the text from the
 files in results/ (report.csv, cells.csv, check.csv, wp.csv, provenance.json,
@@ -22,12 +22,12 @@ machine (machine_busy), and, for a key that ranks solvers (RANKING), every
 study it reads has at least two runs of each cell. Any other number is
 history: it is quoted with an `h:` marker,
 
-    HOT was the fastest on <!-- h:scenes.hot_fastest -->10 of 13<!-- /n --> scenes
+    HOT was <!-- h:stiffness.hot_geomean -->1.84<!-- /n -->x as fast as PN-PCG
 
 and its section (from the heading before it to the next) carries the status
 of every study it reads, a generated marker
 
-    <!-- s:scenes-bench -->scenes-bench: build 24f0c85, ... stale ...<!-- /n -->
+    <!-- s:stiffness -->stiffness: build 7ab7cbd, ... stale ...<!-- /n -->
 
 An `n:` marker whose number is not current, an `h:` marker without its
 studies' status in its section, and an `h:` marker whose number is current
@@ -206,33 +206,6 @@ def run_date(study):
 def run_cpu(study):
     p = provenance(study)[0]
     return f"{p['cpu_model']}, {p['cores_online']} cores"
-
-
-def fastest_per_case(study):
-    best = {}
-    for r in table(study, "report.csv"):
-        if r["status"] != "ok" or not r["s_per_frame"]:
-            continue
-        t = float(r["s_per_frame"])
-        if r["case"] not in best or t < best[r["case"]][1]:
-            best[r["case"]] = (r["solver"], t)
-    if not best:
-        raise Missing(f"results/{study}/report.csv: no ok row")
-    return best
-
-
-def scenes_hot_fastest():
-    best = fastest_per_case("scenes-bench")
-    return of(sum(s == "hot" for s, _ in best.values()), len(best))
-
-
-def scenes_hot_within(factor):
-    best = fastest_per_case("scenes-bench")
-    k = 0
-    for case, (_, t) in best.items():
-        h = one("scenes-bench", case=case, solver="hot")
-        k += h["status"] == "ok" and float(h["s_per_frame"]) <= factor * t
-    return of(k, len(best))
 
 
 def scenes_speedup(solver, scenes):
@@ -489,9 +462,6 @@ def is_petsc_amg(solver):
     return solver in GAMG or ":petsc:pc_type=" in solver
 
 
-ALGT_FORMS = setting_table.TUNED_PRESETS  # preset -> the spec its out-of-sample tuning ran
-
-
 def algt_adopted(form, what):
     """results/algebraic-tuning: the setting its adoption rule took for one
     preset's solver form (setting_table.adoption) and its geometric-mean ratio to
@@ -499,15 +469,15 @@ def algt_adopted(form, what):
     qualified ("winners")."""
     cells = [r for r in table("algebraic-tuning", "cells.csv") if r.get("role", "") != "reference"]
     decided = setting_table.adoption(cells, "variant")
-    if ALGT_FORMS[form] not in decided:
-        raise Missing(f"results/algebraic-tuning: no cells of {ALGT_FORMS[form]}")
-    a = decided[ALGT_FORMS[form]]
+    if setting_table.TUNED_PRESETS[form] not in decided:
+        raise Missing(f"results/algebraic-tuning: no cells of {setting_table.TUNED_PRESETS[form]}")
+    a = decided[setting_table.TUNED_PRESETS[form]]
     if what == "winners":
         return str(sum(1 for j in a["judged"] if j[4]))
     if what == "setting":
         return a["best"][0] if a["best"] else f"none (kept {a['first']})"
     if not a["best"]:
-        raise Missing(f"results/algebraic-tuning: nothing adopted for {ALGT_FORMS[form]}")
+        raise Missing(f"results/algebraic-tuning: nothing adopted for {setting_table.TUNED_PRESETS[form]}")
     return sig(a["best"][1], 2)
 
 
@@ -608,7 +578,6 @@ NUMBERS = {
     "scenes.n_scenes": lambda: scenes_count("scene"),
     "scenes.n_solvers": lambda: scenes_count("solver"),
     "scenes.particles_max": scenes_particles_max,
-    "scenes.hot_fastest": scenes_hot_fastest,
     "scenes.hot_fastest_summary": lambda: fastest("scenes-bench", "hot"),
     "scenes.hot_tied": lambda: str(solver_summary("scenes-bench", "hot")["tied_fastest_in"]),
     "scenes.hot_geomean": lambda: geomean("scenes-bench", "hot"),
@@ -617,7 +586,6 @@ NUMBERS = {
     "history.date": lambda: run_date("scenes-history"),
     "history.hot_geomean": lambda: geomean("scenes-history", "hot"),
     "stiffness.hot_geomean": lambda: geomean("stiffness", "hot"),
-    "scenes.hot_within_2x": lambda: scenes_hot_within(2.0),
     "scenes.hot_vs_pn-pcg_paper": lambda: scenes_speedup("hot", PAPER_SCENES),
     "scenes.pn-mgpcg_vs_pn-pcg_paper": lambda: scenes_speedup("pn-mgpcg", PAPER_SCENES),
     "scenes.pn-amg-pcg_vs_pn-pcg_all": lambda: scenes_speedup(
@@ -714,9 +682,9 @@ NUMBERS = {
     "pb.hot_petsc_over_hot_range": lambda: petsc_baselines_over_hot(lambda so: so == "hot-petsc", "range"),
     "algt.date": lambda: run_date("algebraic-tuning"),
     "algt.cells": lambda: cells_ok("algebraic-tuning"),
-    **{f"algt.{form}_adopted": (lambda form=form: algt_adopted(form, "setting")) for form in ALGT_FORMS},
-    **{f"algt.{form}_over_untuned": (lambda form=form: algt_adopted(form, "ratio")) for form in ALGT_FORMS},
-    **{f"algt.{form}_winners": (lambda form=form: algt_adopted(form, "winners")) for form in ALGT_FORMS},
+    **{f"algt.{form}_adopted": (lambda form=form: algt_adopted(form, "setting")) for form in setting_table.TUNED_PRESETS},
+    **{f"algt.{form}_over_untuned": (lambda form=form: algt_adopted(form, "ratio")) for form in setting_table.TUNED_PRESETS},
+    **{f"algt.{form}_winners": (lambda form=form: algt_adopted(form, "winners")) for form in setting_table.TUNED_PRESETS},
     "bos.date": lambda: run_date("baselines-out-of-sample"),
     "bos.cells": lambda: cells_ok("baselines-out-of-sample"),
     "bos.lead_2t": lambda: bos_lead(2),
