@@ -50,7 +50,8 @@ check "the report names the sampled frames" grep -q "Sampled frames .*sauce: 1,4
 # other solver's total over the sampled frames over HOT's, and the largest per-frame ratio, as the
 # HOT paper's Table 1 defines them; the reference run's whole animation beside its sampled frames
 python3 "$src/scripts/paper_scale_table.py" "$tmp/r" >"$tmp/table.md" 2>"$tmp/table.err"
-check "paper_scale_table.py: exit 0 ($(head -c 200 "$tmp/table.err"))" test $? -eq 0
+rc=$?
+check "paper_scale_table.py: exit 0 ($(head -c 200 "$tmp/table.err"))" test "$rc" -eq 0
 python3 - "$tmp/r" "$tmp/table.md" >"$tmp/tcmp" 2>&1 <<'PY'
 import csv, re, sys
 root, table = sys.argv[1], open(sys.argv[2]).read()
