@@ -298,10 +298,9 @@ DEC_SCENES = ("bar3", "twist", "faceless", "armacat-stiff")
 
 
 def dec_spread(study, solver, eps):
-    """The spread across the scenes of results/decrement (max/min) of the
-    median per-step err_h of one solver spec at one eps, with its range; the
-    CN cells are read from the work-precision study, which ran the same
-    scenes, scales, frames and error reference."""
+    """The spread across the scenes of results/STUDY (decrement, decrement-fine:
+    the same matrix at two scales) of the median per-step err_h of one solver
+    spec at one eps (max/min), with its range."""
     vals = [float(r["err_h_median"]) for r in table(study, "wp.csv")
             if r["case"] in DEC_SCENES and r["solver"] == solver and r["status"] == "ok" and r["eps"]
             and float(r["eps"]) == eps and r["err_h_median"]]
@@ -310,10 +309,22 @@ def dec_spread(study, solver, eps):
     return f"{max(vals) / min(vals):.0f}x ({sig(min(vals), 2)} to {sig(max(vals), 2)}, {len(vals)} scenes)"
 
 
-def dec_egap_over_eps(scene, solver, eps):
-    """e_gap / eps of a decrement cell: how far the rule's promise held."""
-    r = one("decrement", "wp.csv", case=scene, solver=solver, eps=eps)
-    return sig(num(r, "e_gap_median") / float(eps), 2)
+def particle_span(study):
+    """The particle counts of a study's cells, "A to B" (one number when they agree)."""
+    parts = [num(r, "particles") for r in table(study, "cells.csv")]
+    lo, hi = grouped(min(parts)), grouped(max(parts))
+    return lo if lo == hi else f"{lo} to {hi}"
+
+
+def dec_egap_per_eps_max(study):
+    """The largest median e_gap / eps of the decrement-stopped cells of
+    results/STUDY, with its cell: how far the rule's estimate missed."""
+    rows = [r for r in table(study, "wp.csv")
+            if r["solver"].endswith(":stop=decrement") and r["status"] == "ok" and r["e_gap_median"]]
+    if not rows:
+        raise Missing(f"results/{study}/wp.csv: no decrement-stopped cell")
+    r = max(rows, key=lambda r: float(r["e_gap_median"]) / float(r["eps"]))
+    return f"{sig(float(r['e_gap_median']) / float(r['eps']), 2)} (on {r['case']}, {r['solver']}, eps {r['eps']})"
 
 
 def omp_wait_times(load, wait):
@@ -611,11 +622,20 @@ NUMBERS = {
     "wp.err_h_spread_at_1e-7": lambda: wp_err_h_spread(1e-7),
     "dec.cells": lambda: cells_ok("decrement"),
     "dec.date": lambda: run_date("decrement"),
-    "dec.pn-pcg_cn_1e-8": lambda: dec_spread("work-precision", "pn-pcg", 1e-8),
+    "dec.particles": lambda: particle_span("decrement"),
+    "dec.pn-pcg_cn_1e-8": lambda: dec_spread("decrement", "pn-pcg", 1e-8),
     "dec.pn-pcg_dec_1e-4": lambda: dec_spread("decrement", "pn-pcg:stop=decrement", 1e-4),
-    "dec.hot_cn_1e-6": lambda: dec_spread("work-precision", "hot", 1e-6),
+    "dec.hot_cn_1e-6": lambda: dec_spread("decrement", "hot", 1e-6),
     "dec.hot_dec_1e-4": lambda: dec_spread("decrement", "hot:stop=decrement", 1e-4),
-    "dec.twist_egap_over_eps_1e-8": lambda: dec_egap_over_eps("twist", "pn-pcg:stop=decrement", "1e-08"),
+    "dec.egap_per_eps_max": lambda: dec_egap_per_eps_max("decrement"),
+    "decf.cells": lambda: cells_ok("decrement-fine"),
+    "decf.date": lambda: run_date("decrement-fine"),
+    "decf.particles": lambda: particle_span("decrement-fine"),
+    "decf.pn-pcg_cn_1e-8": lambda: dec_spread("decrement-fine", "pn-pcg", 1e-8),
+    "decf.pn-pcg_dec_1e-4": lambda: dec_spread("decrement-fine", "pn-pcg:stop=decrement", 1e-4),
+    "decf.hot_cn_1e-6": lambda: dec_spread("decrement-fine", "hot", 1e-6),
+    "decf.hot_dec_1e-4": lambda: dec_spread("decrement-fine", "hot:stop=decrement", 1e-4),
+    "decf.egap_per_eps_max": lambda: dec_egap_per_eps_max("decrement-fine"),
     "ompwait.idle_spin10k_vs_default": lambda: omp_wait_ratio("idle", "spin10k", "idle", "omp_default"),
     "ompwait.idle_spin1k_vs_default": lambda: omp_wait_ratio("idle", "spin1k", "idle", "omp_default"),
     "ompwait.idle_passive_vs_default": lambda: omp_wait_ratio("idle", "passive", "idle", "omp_default"),
