@@ -580,6 +580,20 @@ def fig8_blocks(solver, level):
     return f"{float(lv['blocks_per_row_avg']):.0f}"
 
 
+def dec_keys(prefix, study):
+    """The decrement study's numbers, one set per scale (decrement, decrement-fine)."""
+    return {
+        f"{prefix}.cells": lambda: cells_ok(study),
+        f"{prefix}.date": lambda: run_date(study),
+        f"{prefix}.particles": lambda: particle_span(study),
+        f"{prefix}.pn-pcg_cn_1e-8": lambda: dec_spread(study, "pn-pcg", 1e-8),
+        f"{prefix}.pn-pcg_dec_1e-4": lambda: dec_spread(study, "pn-pcg:stop=decrement", 1e-4),
+        f"{prefix}.hot_cn_1e-6": lambda: dec_spread(study, "hot", 1e-6),
+        f"{prefix}.hot_dec_1e-4": lambda: dec_spread(study, "hot:stop=decrement", 1e-4),
+        f"{prefix}.egap_per_eps_max": lambda: dec_egap_per_eps_max(study),
+    }
+
+
 NUMBERS = {
     "scenes.cells": lambda: cells_ok("scenes-bench"),
     "scenes.minutes": lambda: cells_total_minutes("scenes-bench"),
@@ -620,22 +634,8 @@ NUMBERS = {
     "wp.date": lambda: run_date("work-precision"),
     "wp.err_h_range_at_1e-7": lambda: wp_err_h_range(1e-7),
     "wp.err_h_spread_at_1e-7": lambda: wp_err_h_spread(1e-7),
-    "dec.cells": lambda: cells_ok("decrement"),
-    "dec.date": lambda: run_date("decrement"),
-    "dec.particles": lambda: particle_span("decrement"),
-    "dec.pn-pcg_cn_1e-8": lambda: dec_spread("decrement", "pn-pcg", 1e-8),
-    "dec.pn-pcg_dec_1e-4": lambda: dec_spread("decrement", "pn-pcg:stop=decrement", 1e-4),
-    "dec.hot_cn_1e-6": lambda: dec_spread("decrement", "hot", 1e-6),
-    "dec.hot_dec_1e-4": lambda: dec_spread("decrement", "hot:stop=decrement", 1e-4),
-    "dec.egap_per_eps_max": lambda: dec_egap_per_eps_max("decrement"),
-    "decf.cells": lambda: cells_ok("decrement-fine"),
-    "decf.date": lambda: run_date("decrement-fine"),
-    "decf.particles": lambda: particle_span("decrement-fine"),
-    "decf.pn-pcg_cn_1e-8": lambda: dec_spread("decrement-fine", "pn-pcg", 1e-8),
-    "decf.pn-pcg_dec_1e-4": lambda: dec_spread("decrement-fine", "pn-pcg:stop=decrement", 1e-4),
-    "decf.hot_cn_1e-6": lambda: dec_spread("decrement-fine", "hot", 1e-6),
-    "decf.hot_dec_1e-4": lambda: dec_spread("decrement-fine", "hot:stop=decrement", 1e-4),
-    "decf.egap_per_eps_max": lambda: dec_egap_per_eps_max("decrement-fine"),
+    **dec_keys("dec", "decrement"),
+    **dec_keys("decf", "decrement-fine"),
     "ompwait.idle_spin10k_vs_default": lambda: omp_wait_ratio("idle", "spin10k", "idle", "omp_default"),
     "ompwait.idle_spin1k_vs_default": lambda: omp_wait_ratio("idle", "spin1k", "idle", "omp_default"),
     "ompwait.idle_passive_vs_default": lambda: omp_wait_ratio("idle", "passive", "idle", "omp_default"),
