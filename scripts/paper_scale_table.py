@@ -17,7 +17,6 @@ far HOT's sampled frames stand for its whole animation (the reference run's
 seconds per frame beside the sample's). A cell that did not meet eps on a
 quiet machine is marked and left out of the summary, as the report does.
 """
-import math
 import os
 import statistics
 import sys
@@ -71,10 +70,6 @@ def fastest(study, among):
     return out
 
 
-def fmt(x, digits=3):
-    return "-" if x is None or not math.isfinite(x) else f"{x:.{digits}g}"
-
-
 def span(xs):
     return f"{min(xs):.3g}-{max(xs):.3g}"
 
@@ -123,7 +118,7 @@ def main(d):
         cols = []
         for so in others:
             sp = mr.Speedup(h, timed[(sc, so)])
-            cols.append("-" if sp.total is None else f"{sp.text()} / {fmt(sp.per)}")
+            cols.append("-" if sp.total is None else f"{sp.text()} / {mr.fmt(sp.per)}")
         print(f"| {sc} | {int(mr.number(h.row.get('particles'), 0)):,} | {frames} | " + " | ".join(cols) + " |")
 
     print("\nSeconds per sampled frame (median of the runs); iterations over the sampled frames in the first "
@@ -139,7 +134,7 @@ def main(d):
             marks = "".join(f" {m}" for m in c.marks())
             its = f"{c.outer} / {c.linear} / {c.row.get('inner_iters') or '-'}"
             mb = max((mr.number(r.row.get("peak_rss_mb"), 0.0) for r in c.runs), default=0.0)
-            cols.append(f"{fmt(c.s_per_frame)}{marks}; {its}; {mb:.0f} MB")
+            cols.append(f"{mr.fmt(c.s_per_frame)}{marks}; {its}; {mb:.0f} MB")
         print(f"| {sc} | " + " | ".join(cols) + " |")
 
     print("\nHow far the sampled frames stand for the whole animation: each scene's reference run simulated "
@@ -156,9 +151,9 @@ def main(d):
         slowest = max(ref.frame_time.values()) if ref.frame_time else float("nan")
         whole = ref.s_per_frame
         busy = " busy" if ref.busy else ""
-        print(f"| {sc} | {ref.solver} | {len(ref.frame_time)} | {ref.row.get('steps', '-')} | {fmt(whole)}{busy} | "
-              f"{fmt(slowest)} | {fmt(same.s_per_frame)} | "
-              f"{fmt(same.s_per_frame / whole if whole else float('nan'))} | "
+        print(f"| {sc} | {ref.solver} | {len(ref.frame_time)} | {ref.row.get('steps', '-')} | {mr.fmt(whole)}{busy} | "
+              f"{mr.fmt(slowest)} | {mr.fmt(same.s_per_frame)} | "
+              f"{mr.fmt(same.s_per_frame / whole if whole else float('nan'))} | "
               f"{mr.number(ref.row.get('peak_rss_mb'), 0.0):.0f} |")
     runs = [r for c in timed.values() for r in c.runs]
     print(f"\n{len(runs)} timed runs, {sum(r.busy for r in runs)} on a busy machine, "

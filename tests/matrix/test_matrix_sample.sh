@@ -52,8 +52,10 @@ check "the report names the sampled frames" grep -q "Sampled frames .*sauce: 1,4
 python3 "$src/scripts/paper_scale_table.py" "$tmp/r" >"$tmp/table.md" 2>"$tmp/table.err"
 rc=$?
 check "paper_scale_table.py: exit 0 ($(head -c 200 "$tmp/table.err"))" test "$rc" -eq 0
-python3 - "$tmp/r" "$tmp/table.md" >"$tmp/tcmp" 2>&1 <<'PY'
+python3 - "$tmp/r" "$tmp/table.md" "$src/scripts" >"$tmp/tcmp" 2>&1 <<'PY'
 import csv, re, sys
+sys.path.insert(0, sys.argv[3])
+from matrix_report import fmt  # the table's number format
 root, table = sys.argv[1], open(sys.argv[2]).read()
 cells = [c for c in csv.DictReader(open(f"{root}/cells.csv")) if c["scene"] == "sauce"]
 def frames(solver, role="cell"):
@@ -62,14 +64,14 @@ def frames(solver, role="cell"):
 hot, pn = frames("hot"), frames("pn-pcg")
 total = sum(pn.values()) / sum(hot.values())
 per = max(pn[k] / hot[k] for k in hot)
-row = f"| sauce | {int(cells[0]['particles']):,} | 1, 4, 6 | {total:.3g}"
+row = f"| sauce | {int(cells[0]['particles']):,} | 1, 4, 6 | {fmt(total)}"
 assert row in table, (row, [l for l in table.splitlines() if l.startswith("| sauce")])
-assert f" / {per:.3g} |" in table, per
+assert f" / {fmt(per)} |" in table, per
 whole = frames("pn-pcg", "reference")
 ref = f"| sauce | pn-pcg | {len(whole)} | "
 line = next((l for l in table.splitlines() if l.startswith(ref)), "")
 # the whole animation's s/frame, marked busy when the machine was loaded (this test may share it)
-assert re.search(rf"\| {sum(whole.values()) / len(whole):.3g}( busy)? \|", line), (ref, line)
+assert re.search(rf"\| {re.escape(fmt(sum(whole.values()) / len(whole)))}( busy)? \|", line), (ref, line)
 assert "| bar3 | pn-pcg |" not in table, "bar3 has no reference run"
 print("ok")
 PY
