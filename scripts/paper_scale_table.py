@@ -71,7 +71,7 @@ def fastest(study, among):
 
 
 def span(xs):
-    return f"{min(xs):.3g}-{max(xs):.3g}"
+    return f"{mr.fmt(min(xs))}-{mr.fmt(max(xs))}"
 
 
 def main(d):
