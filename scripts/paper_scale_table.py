@@ -3,6 +3,7 @@
 run of experiments/matrices/paper-scale.json:
 
     python3 scripts/paper_scale_table.py results/paper-scale > results/paper-scale/table.md
+    python3 scripts/paper_scale_table.py --rerun-bounds OLD_DIR NEW_DIR MPMBENCH
 
 Each scene's whole animation is simulated once by HOT (the reference run,
 which writes checkpoints); every cell then times the same three frames of it
@@ -16,9 +17,20 @@ every frame). Then seconds per frame, iterations and peak memory, and how
 far HOT's sampled frames stand for its whole animation (the reference run's
 seconds per frame beside the sample's). A cell that did not meet eps on a
 quiet machine is marked and left out of the summary, as the report does.
+
+A solver too slow to time three times on a scene (a pair the matrix
+excludes) can be given a bound instead: one `mpmbench run` of it from the
+same checkpoints and sampled frames, stopped by --max-run-seconds, with its
+--out in DIR/bounds/NAME/. Its seconds are a lower bound on its total over
+the sample, so HOT's speedup over it is at least those seconds over HOT's
+slowest run, and the table prints it as such. --rerun-bounds runs the
+bounds of a study again into a rerun of it (scripts/reproduce.sh does).
 """
+import glob
+import json
 import os
 import statistics
+import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -40,6 +52,131 @@ def load(d):
     scenes = axes.get("scene") or list(dict.fromkeys(s for s, _ in timed))
     solvers = axes.get("solver") or list(dict.fromkeys(s for _, s in timed))
     return meta, scenes, solvers, timed, refs
+
+
+class Bound:
+    """One run of DIR/bounds/NAME/ (run.json, frames.csv): a solver timed on a scene's sampled
+    frames from the reference's checkpoints and stopped by its time limit. spent: its seconds
+    over the sample until then, a lower bound on its total; at: the frame (and the step count
+    there) where it stopped; frame_time: frame -> seconds, the cut frame's a lower bound."""
+
+    def __init__(self, path):
+        self.path = path
+        try:
+            with open(os.path.join(path, "run.json")) as f:
+                run = json.load(f)
+        except (OSError, ValueError) as e:
+            mr.die(f"{path}/run.json: {e}")
+        frames = mr.read_csv(os.path.join(path, "frames.csv"))
+        if not frames:
+            mr.die(f"{path}/frames.csv: missing or empty")
+        self.scene, self.solver = run.get("scene"), run.get("solver")
+        self.eps, self.scale, self.threads = run.get("eps"), run.get("scale"), run.get("threads")
+        ck = run.get("checkpoints") or {}
+        self.sample_from, self.sample_frames = ck.get("sample_from") or "", ck.get("sample_frames") or ""
+        self.limit = (run.get("limits") or {}).get("max_run_seconds") or 0.0
+        self.overrides = run.get("overrides") or {}
+        self.commit = ((run.get("provenance") or {}).get("build") or {}).get("git_commit")
+        self.busy = bool((run.get("machine_load") or {}).get("machine_busy"))
+        ran = [f for f in frames if int(mr.number(f.get("steps"), 0)) > 0]  # not the 0-step row of the frame after
+        self.frame_time = {int(mr.number(f.get("frame"), -1)): mr.number(f.get("wall_s"), 0.0) for f in ran}
+        self.spent = sum(self.frame_time.values())
+        self.iters = tuple(sum(int(mr.number(f.get(k), 0)) for f in frames)
+                           for k in ("outer_iters", "linear_iters", "inner_iters"))
+
+        def stopped(f):  # the row of the frame the limit cut (its last step's solve, or the frame itself)
+            return mr.frame_cut_short(f) or (f.get("status") == "timeout" and
+                                             "--max-run-seconds" in (f.get("reason") or ""))
+        cut = [f for f in ran if stopped(f)] or [f for f in frames if stopped(f)]
+        self.cut = bool(cut)
+        self.at = (int(mr.number(cut[0].get("frame"), -1)), int(mr.number(cut[0].get("steps"), 0))) if cut else None
+        # the frames before the stop must have met eps: else the seconds are not those of reaching it
+        self.failed = [f.get("frame") for f in frames if not stopped(f) and f.get("status") != "converged"]
+
+    def check(self, hot, study_commit):
+        """Dies (one line, exit 2) unless the run times the same states as the study's cells of its
+        scene: the reference's checkpoints, the sampled frames, eps, scale, threads and build; and
+        unless its time limit cut it short (a whole run is a cell of the matrix, not a bound)."""
+        try:
+            with open(os.path.join(hot.dir, "run.json")) as f:
+                hot_overrides = json.load(f).get("overrides") or {}
+        except (OSError, ValueError) as e:
+            mr.die(f"{hot.dir}/run.json: {e}")
+        want = {"sample_frames": hot.row.get("sample_frames"), "eps": mr.number(hot.row.get("eps")),
+                "scale": mr.number(hot.row.get("scale")), "threads": int(mr.number(hot.row.get("threads"), 0)),
+                "git_commit": study_commit, "overrides": hot_overrides}
+        got = {"sample_frames": self.sample_frames, "eps": self.eps, "scale": self.scale, "threads": self.threads,
+               "git_commit": self.commit, "overrides": self.overrides}
+        for k, v in want.items():
+            if got[k] != v:
+                mr.die(f"{self.path}/run.json: {k} {got[k]!r}, but the study's {self.scene} cells ran with {v!r}")
+        ref = f"cells/{hot.row.get('reference')}/checkpoints"
+        if not self.sample_from.rstrip("/").endswith(ref):
+            mr.die(f"{self.path}/run.json: checkpoints.sample_from {self.sample_from!r} is not the study's "
+                   f"{self.scene} reference ({ref})")
+        if not self.cut or not self.limit:
+            mr.die(f"{self.path}/frames.csv: the run was not stopped by --max-run-seconds: "
+                   "a whole run belongs in the matrix, not in bounds/")
+
+    def text(self):
+        frame, steps = self.at
+        return (f"stopped by its limit of {mr.fmt(self.limit)} s in frame {frame}"
+                + (f", step {steps} of it (counted from 1)" if steps else ", before its first step") + ", one run"
+                + ("; busy" if self.busy else "") + (f"; frames not converged: {', '.join(self.failed)}"
+                                                     if self.failed else ""))
+
+
+def study_commit(cells):
+    """The build every timed cell ran (run.json provenance); dies when there are several."""
+    commits = set()
+    for c in cells:
+        for r in c.runs:
+            try:
+                with open(os.path.join(r.dir, "run.json")) as f:
+                    commits.add(json.load(f)["provenance"]["build"]["git_commit"])
+            except (OSError, ValueError, KeyError, TypeError):
+                pass
+    if len(commits) > 1:
+        mr.die(f"the cells ran on {len(commits)} builds ({', '.join(sorted(commits))}): not one study")
+    return commits.pop() if commits else None
+
+
+def excluded(meta, scene, solver):
+    """Does an exclude rule of the matrix (one of scene and solver only) drop this pair?"""
+    def hits(rule, key, value):
+        v = rule.get(key, value)
+        return value in v if isinstance(v, list) else v == value
+    rules = (meta.get("matrix") or {}).get("exclude") or []
+    return any(set(r) <= {"scene", "solver"} and hits(r, "scene", scene) and hits(r, "solver", solver)
+               for r in rules)
+
+
+def load_bounds(d, timed):
+    """{(scene, solver): Bound} of DIR/bounds/*/, each checked against the HOT cell of its scene."""
+    root = os.path.join(d, "bounds")
+    names = sorted(os.listdir(root)) if os.path.isdir(root) else []
+    commit = study_commit(timed.values())
+    out = {}
+    for name in names:
+        b = Bound(os.path.join(root, name))
+        hot = timed.get((b.scene, HOT))
+        if hot is None:
+            mr.die(f"{b.path}/run.json: scene {b.scene!r} has no timed {HOT} cell in {d}")
+        if (b.scene, b.solver) in timed:
+            mr.die(f"{b.path}/run.json: {b.scene}/{b.solver} is also a timed cell of the study: one or the other")
+        b.check(hot, commit)
+        out[(b.scene, b.solver)] = b
+    return out
+
+
+def bound_speedups(bound, hot):
+    """HOT's speedup over a bounded solver, at least: (total, largest per-frame ratio), each the
+    bound's seconds over HOT's slowest run (so no run of HOT could make it smaller)."""
+    n = len(hot.timed)
+    total = bound.spent / max(r.s_per_frame * n for r in hot.runs)
+    per = max((t / max(r.timed.get(k, float("inf")) for r in hot.runs)
+               for k, t in bound.frame_time.items() if k in hot.timed), default=None)
+    return total, per
 
 
 def hot_speedups(study):
@@ -76,13 +213,24 @@ def span(xs):
 
 def main(d):
     study = load(d)
-    _, scenes, solvers, timed, refs = study
+    meta, scenes, solvers, timed, refs = study
     others = [s for s in solvers if s != HOT]
     speed = hot_speedups(study)
     paper_set = [so for so in solvers if so == HOT or so in PAPER_TOTAL]
     wins = fastest(study, paper_set)
-    done = [sc for sc in scenes if all((sc, so) in timed for so in solvers)]
-    missing = [sc for sc in scenes if sc not in done]
+    bounds = load_bounds(d, timed)
+    unranked = {}  # scene -> why a bound leaves its fastest open
+    for (sc, so), b in bounds.items():
+        if so in paper_set and wins.get(sc):
+            best = timed[(sc, wins[sc][0])]
+            if not b.spent / len(best.timed) > best.hi or b.busy or b.failed:
+                unranked[sc] = f"{so}'s bound does not show it slower than {best.solver}"
+                wins[sc] = None
+    done = [sc for sc in scenes if all((sc, so) in timed or (sc, so) in bounds for so in solvers)]
+    missing = [sc for sc in scenes if sc not in done and not all(
+        (sc, so) in timed or excluded(meta, sc, so) for so in solvers)]
+    unbounded = [f"{sc}/{so}" for sc in scenes for so in solvers
+                 if sc not in done and sc not in missing and (sc, so) not in timed and (sc, so) not in bounds]
 
     print("# HOT supplement Table 1 at the paper's scale, like for like\n")
     ranked = [sc for sc in done if wins.get(sc)]
@@ -94,18 +242,28 @@ def main(d):
           f"by more than the spread of the runs, tied for the fastest on {len(tied)}"
           + (f" ({', '.join(tied)})" if tied else "")
           + (f"; slower on {', '.join(f'{sc} (fastest: {wins[sc][0]})' for sc in lost)}" if lost else "")
+          + (f"; unranked: {'; '.join(f'{sc} ({why})' for sc, why in unranked.items())}" if unranked else "")
           + ". The paper: HOT the fastest of these on all but two of its ten scenes.")
     for so in others:
         sp = speed.get(so, {})
-        if not sp:
+        bounded = [(sc, b) for (sc, o), b in bounds.items() if o == so and sc in done and not b.busy]
+        if not sp and not bounded:
             continue
         tot = [s.total for s in sp.values()]
         per = [s.per for s in sp.values() if s.per]
         paper = f"; the paper: {PAPER_TOTAL[so]}x" if so in PAPER_TOTAL else "; the paper has no such solver"
-        print(f"- HOT against {so}: {mr.geomean(tot):.2f}x as fast in total (geometric mean over {len(tot)} scenes, "
-              f"{span(tot)}x), largest per-frame ratio {span(per)}x{paper}.")
+        line = (f"- HOT against {so}: {mr.geomean(tot):.2f}x as fast in total (geometric mean over {len(tot)} "
+                f"scenes, {span(tot)}x), largest per-frame ratio {span(per)}x" if tot else f"- HOT against {so}:")
+        for sc, b in bounded:
+            total, fr = bound_speedups(b, timed[(sc, HOT)])
+            line += (f"{';' if tot else ''} on {sc} at least {mr.fmt(total)}x in total and {mr.fmt(fr)}x "
+                     f"on a frame ({b.text()})")
+        print(line + f"{paper}.")
     if missing:
         print(f"- Not run yet: {', '.join(missing)} (`matrix run` resumes).")
+    if unbounded:
+        print(f"- Excluded from the matrix and not bounded yet: {', '.join(unbounded)} (a run stopped by "
+              "--max-run-seconds into DIR/bounds/, as this script's help says).")
 
     print("\nHOT's speedup over each solver, total over the sampled frames (median of the runs; range "
           "over the runs in brackets) and the largest per-frame ratio of the sampled frames after the "
@@ -117,6 +275,11 @@ def main(d):
         frames = ", ".join(str(k) for k in sorted(h.timed))
         cols = []
         for so in others:
+            if (sc, so) in bounds:
+                b = bounds[(sc, so)]
+                total, fr = bound_speedups(b, h)
+                cols.append(f"≥ {mr.fmt(total)} / ≥ {mr.fmt(fr)} (bound{' busy' if b.busy else ''})")
+                continue
             sp = mr.Speedup(h, timed[(sc, so)])
             cols.append("-" if sp.total is None else f"{sp.text()} / {mr.fmt(sp.per)}")
         print(f"| {sc} | {int(mr.number(h.row.get('particles'), 0)):,} | {frames} | " + " | ".join(cols) + " |")
@@ -130,6 +293,11 @@ def main(d):
     for sc in done:
         cols = []
         for so in solvers:
+            if (sc, so) in bounds:
+                b = bounds[(sc, so)]
+                o, li, inner = b.iters
+                cols.append(f"≥ {mr.fmt(b.spent / len(timed[(sc, HOT)].timed))} (bound); ≥ {o} / {li} / {inner}")
+                continue
             c = timed[(sc, so)]
             marks = "".join(f" {m}" for m in c.marks())
             its = f"{c.outer} / {c.linear} / {c.row.get('inner_iters') or '-'}"
@@ -155,14 +323,52 @@ def main(d):
               f"{mr.fmt(slowest)} | {mr.fmt(same.s_per_frame)} | "
               f"{mr.fmt(same.s_per_frame / whole if whole else float('nan'))} | "
               f"{mr.number(ref.row.get('peak_rss_mb'), 0.0):.0f} |")
+    if bounds:
+        print("\nBounds: solvers a scene could not time three times, each run once from the same checkpoints "
+              "and stopped by a time limit; seconds per sampled frame up to the stop (the last one cut short), "
+              "against HOT's slowest run on the same frame:\n")
+        print("| scene | solver | stopped | seconds per frame | HOT's slowest, s |")
+        print("|---|---|---|---|---|")
+        for (sc, so), b in sorted(bounds.items()):
+            hot = timed[(sc, HOT)]
+            secs = ", ".join(f"{k}: {mr.fmt(t)}" for k, t in sorted(b.frame_time.items()))
+            slow = ", ".join(f"{k}: {mr.fmt(max(r.timed.get(k, float('nan')) for r in hot.runs))}"
+                             for k in sorted(hot.timed))
+            print(f"| {sc} | {so} | {b.text()} | {secs} | {slow} |")
     runs = [r for c in timed.values() for r in c.runs]
     print(f"\n{len(runs)} timed runs, {sum(r.busy for r in runs)} on a busy machine, "
           f"{sum(1 for r in runs if r.status != 'ok')} not ok; "
           f"median runs a cell {statistics.median(len(c.runs) for c in timed.values()):.0f}.")
 
 
+def rerun_bounds(old, new, binary):
+    """Runs every bound of the study OLD again into NEW/bounds/ with BINARY, the same way: the same
+    scene, solver, eps, scale, threads, overrides, sampled frames and time limit, from the
+    checkpoints of the same reference cell in NEW (whose id the same settings keep)."""
+    for run_json in sorted(glob.glob(os.path.join(old, "bounds", "*", "run.json"))):
+        try:
+            with open(run_json) as f:
+                r = json.load(f)
+            ck = r["checkpoints"]
+            ref = os.path.basename(os.path.dirname(ck["sample_from"].rstrip("/")))
+            cmd = [binary, "run", "--scene", r["scene"], "--solver", r["solver"], "--eps", repr(r["eps"]),
+                   "--scale", repr(r["scale"]), "--threads", str(r["threads"]),
+                   "--sample-from", os.path.join(new, "cells", ref, "checkpoints"),
+                   "--sample-frames", ck["sample_frames"], "--max-run-seconds", repr(r["limits"]["max_run_seconds"]),
+                   "--out", os.path.join(new, "bounds", os.path.basename(os.path.dirname(run_json)))]
+            cmd += [a for k, v in (r.get("overrides") or {}).items() for a in ("--set", f"{k}={v}")]
+        except (OSError, ValueError, KeyError, TypeError, AttributeError) as e:
+            mr.die(f"{run_json}: {e!r}")
+        print("paper_scale_table.py: bound: " + " ".join(cmd), flush=True)
+        if subprocess.run(cmd).returncode != 0:
+            mr.die(f"{run_json}: its rerun failed", 1)
+
+
 if __name__ == "__main__":
-    if len(sys.argv) != 2:
-        print("usage: paper_scale_table.py RESULTS_DIR", file=sys.stderr)
+    if len(sys.argv) == 5 and sys.argv[1] == "--rerun-bounds":
+        rerun_bounds(*sys.argv[2:])
+    elif len(sys.argv) == 2:
+        main(sys.argv[1])
+    else:
+        print("usage: paper_scale_table.py RESULTS_DIR | --rerun-bounds OLD_DIR NEW_DIR MPMBENCH", file=sys.stderr)
         sys.exit(2)
-    main(sys.argv[1])

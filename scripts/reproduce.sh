@@ -79,6 +79,9 @@ rm -rf "$dir.new"
 start=$(date +%s)
 # shellcheck disable=SC2086
 "${launcher[@]}" "$bin" matrix run "$file" $args --out "$dir.new"
+# the study's bounds (a solver too slow to time in the matrix, run once from the same checkpoints and
+# stopped by its --max-run-seconds: scripts/paper_scale_table.py), run again the same way
+python3 scripts/paper_scale_table.py --rerun-bounds "$dir" "$dir.new" "$bin"
 "$bin" matrix report "$dir.new"
 rm -rf "$dir"
 mv "$dir.new" "$dir"

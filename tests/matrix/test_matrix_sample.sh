@@ -6,7 +6,9 @@
 # has exactly those frames, the writing solver's sampled rows repeat the
 # reference run's, cells.csv gets a sample_frames column and the report
 # says which frames were sampled; scripts/paper_scale_table.py computes
-# HOT's speedups from the sampled frames; other scenes run as before; a second
+# HOT's speedups from the sampled frames, and a lower bound on them from a
+# run the matrix excludes, stopped by its time limit (DIR/bounds/NAME/),
+# refusing one that timed other states or was not stopped; other scenes run as before; a second
 # `matrix run` has nothing to do; the sampled frames are part of the ids;
 # a bad list, or first_timed_frame beside sample_frames, is a one-line
 # error, exit 2.
@@ -14,9 +16,10 @@
 cat >"$tmp/m.json" <<'EOF2'
 {"name": "sampled",
  "defaults": {"threads": 2, "scale": 5},
- "axes": {"scene": ["sauce", "bar3"], "solver": ["pn-pcg", "hot"]},
+ "axes": {"scene": ["sauce", "bar3"], "solver": ["pn-pcg", "hot", "lbfgs-h"]},
  "scenes": {"sauce": {"reference": {"solver": "pn-pcg", "eps": 1e-7, "sample_frames": "1,4,6"}},
-            "bar3": {"frames": 1}}}
+            "bar3": {"frames": 1}},
+ "exclude": [{"scene": "sauce", "solver": "lbfgs-h"}]}
 EOF2
 "$bin" matrix run "$tmp/m.json" --out "$tmp/r" >"$tmp/run.txt" 2>&1
 check "matrix run: exit 0" test $? -eq 0
@@ -45,6 +48,16 @@ PY
 check "sampled cells: the frames, the column, the writing solver's rows ($(tail -1 "$tmp/cmp"))" grep -qx ok "$tmp/cmp"
 "$bin" matrix report "$tmp/r" >/dev/null 2>&1
 check "the report names the sampled frames" grep -q "Sampled frames .*sauce: 1,4,6" "$tmp/r/report.md"
+
+python3 "$src/scripts/paper_scale_table.py" "$tmp/r" >"$tmp/table0.md" 2>&1
+check "the table before the bound: sauce waits for it, not for the matrix" \
+  bash -c "grep -q 'Excluded from the matrix and not bounded yet: sauce/lbfgs-h (' '$tmp/table0.md' && ! grep -q '^| sauce | ' '$tmp/table0.md'"
+# a bound: sauce/lbfgs-h is excluded from the matrix and run once from the same checkpoints, stopped
+# by a time limit every step exceeds (so the outcome does not depend on the machine's speed)
+bound="$tmp/r/bounds/sauce-lbfgs-h"
+"$bin" run --scene sauce --solver lbfgs-h --scale 5 --threads 2 --sample-from "$tmp/r/cells/$ref/checkpoints" \
+  --sample-frames 1,4,6 --max-run-seconds 1e-6 --quiet --out "$bound" >"$tmp/bound.txt" 2>&1
+check "the bounded run stops at its limit (exit 0)" test $? -eq 0
 
 # the paper-scale table (scripts/paper_scale_table.py) on the sampled study: HOT's speedup is the
 # other solver's total over the sampled frames over HOT's, and the largest per-frame ratio, as the
@@ -76,6 +89,58 @@ assert "| bar3 | pn-pcg |" not in table, "bar3 has no reference run"
 print("ok")
 PY
 check "the table's speedups and reference row from the frames ($(tail -1 "$tmp/tcmp"))" grep -qx ok "$tmp/tcmp"
+
+python3 - "$tmp/r" "$tmp/table.md" "$src/scripts" "$bound" >"$tmp/bcmp" 2>&1 <<'PY'
+import csv, sys
+sys.path.insert(0, sys.argv[3])
+from matrix_report import fmt
+root, table, bound = sys.argv[1], open(sys.argv[2]).read(), sys.argv[4]
+cells = [c for c in csv.DictReader(open(f"{root}/cells.csv")) if c["scene"] == "sauce" and c["role"] == "cell"]
+hot = next(c for c in cells if c["solver"] == "hot")
+h = {r["frame"]: float(r["wall_s"]) for r in csv.DictReader(open(f"{root}/cells/{hot['id']}/frames.csv"))}
+b = list(csv.DictReader(open(f"{bound}/frames.csv")))
+assert b and b[-1]["complete"] == "0", b
+total = sum(float(r["wall_s"]) for r in b) / sum(h.values())
+per = max(float(r["wall_s"]) / h[r["frame"]] for r in b)
+row = next((l for l in table.splitlines() if l.startswith("| sauce | ")), "")
+assert row.rstrip(" |").split(" | ")[-1].startswith(f"≥ {fmt(total)} / ≥ {fmt(per)} (bound"), (total, per, row)
+assert f"| sauce | lbfgs-h | stopped by its limit of {fmt(1e-6)} s in frame 1, step 1 of it" in table, "bounds table"
+assert "Not run yet: " not in table or "sauce" not in table.split("Not run yet: ")[1].split("\n")[0], "sauce is done"
+print("ok")
+PY
+check "the bound: at least its seconds over HOT's ($(tail -1 "$tmp/bcmp"))" grep -qx ok "$tmp/bcmp"
+# a rerun of the study (scripts/reproduce.sh) runs its bounds again the same way, from its own checkpoints
+cp -r "$tmp/r" "$tmp/r2" && rm -r "$tmp/r2/bounds"
+python3 "$src/scripts/paper_scale_table.py" --rerun-bounds "$tmp/r" "$tmp/r2" "$bin" >"$tmp/rerun.txt" 2>&1
+rc=$?
+python3 - "$bound/run.json" "$tmp/r2/bounds/sauce-lbfgs-h/run.json" "$tmp/r2/cells/$ref/checkpoints" >"$tmp/rcmp" 2>&1 <<'PY'
+import json, sys
+a, b = (json.load(open(p)) for p in sys.argv[1:3])
+for k in ("scene", "solver", "eps", "scale", "threads", "overrides"):
+    assert a[k] == b[k], (k, a[k], b[k])
+assert a["limits"]["max_run_seconds"] == b["limits"]["max_run_seconds"] == 1e-6, (a["limits"], b["limits"])
+assert a["checkpoints"]["sample_frames"] == b["checkpoints"]["sample_frames"] == "1,4,6"
+assert b["checkpoints"]["sample_from"] == sys.argv[3], b["checkpoints"]["sample_from"]
+print("ok")
+PY
+check "--rerun-bounds: exit $rc, the same run from the rerun's checkpoints ($(tail -1 "$tmp/rcmp"))" \
+  bash -c "test $rc -eq 0 && grep -qx ok '$tmp/rcmp' && python3 '$src/scripts/paper_scale_table.py' '$tmp/r2' >/dev/null"
+# a bound of other states, or one its limit did not stop, is refused: one line, exit 2
+mv "$bound" "$tmp/bound.ok"
+cp -r "$tmp/bound.ok" "$bound"
+sed -i 's/"sample_frames": "1,4,6"/"sample_frames": "1,4"/' "$bound/run.json"
+python3 "$src/scripts/paper_scale_table.py" "$tmp/r" >/dev/null 2>"$tmp/berr1"
+rc=$?
+check "a bound of other frames: exit 2, one line ($(head -c 200 "$tmp/berr1"))" \
+  bash -c "test $rc -eq 2 && test \$(wc -l <'$tmp/berr1') -eq 1 && grep -q \"sauce-lbfgs-h/run.json: sample_frames '1,4', but the study's sauce cells ran with '1,4,6'\" '$tmp/berr1'"
+rm -r "$bound"
+"$bin" run --scene sauce --solver lbfgs-h --scale 5 --threads 2 --sample-from "$tmp/r/cells/$ref/checkpoints" \
+  --sample-frames 1,4,6 --quiet --out "$bound" >"$tmp/whole.txt" 2>&1
+python3 "$src/scripts/paper_scale_table.py" "$tmp/r" >/dev/null 2>"$tmp/berr2"
+rc=$?
+check "a bound its limit did not stop: exit 2 ($(head -c 200 "$tmp/berr2"))" \
+  bash -c "test $rc -eq 2 && grep -q 'frames.csv: the run was not stopped by --max-run-seconds' '$tmp/berr2'"
+rm -r "$bound"
 "$bin" matrix run "$tmp/m.json" --out "$tmp/r" >"$tmp/again.txt" 2>&1
 check "resume: nothing left" grep -q "0 to run" "$tmp/again.txt"
 
