@@ -226,6 +226,7 @@ class Cell:
                 run = json.load(f)
         except (OSError, ValueError):
             pass
+        self.run = run  # run.json as read ({} when missing): settings and provenance
         # the counts the run used where the matrix left them to the scene / OpenMP (older cells.csv wrote 0)
         for col, key in (("frames_asked", "frames"), ("threads", "threads")):
             if row.get(col) == "0" and isinstance(run.get(key), int) and run[key] > 0:

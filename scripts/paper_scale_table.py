@@ -97,11 +97,7 @@ class Bound:
         """Dies (one line, exit 2) unless the run times the same states as the study's cells of its
         scene: the reference's checkpoints, the sampled frames, eps, scale, threads and build; and
         unless its time limit cut it short (a whole run is a cell of the matrix, not a bound)."""
-        try:
-            with open(os.path.join(hot.dir, "run.json")) as f:
-                hot_overrides = json.load(f).get("overrides") or {}
-        except (OSError, ValueError) as e:
-            mr.die(f"{hot.dir}/run.json: {e}")
+        hot_overrides = hot.run.get("overrides") or {}
         want = {"sample_frames": hot.row.get("sample_frames"), "eps": mr.number(hot.row.get("eps")),
                 "scale": mr.number(hot.row.get("scale")), "threads": int(mr.number(hot.row.get("threads"), 0)),
                 "git_commit": study_commit, "overrides": hot_overrides}
@@ -128,14 +124,8 @@ class Bound:
 
 def study_commit(cells):
     """The build every timed cell ran (run.json provenance); dies when there are several."""
-    commits = set()
-    for c in cells:
-        for r in c.runs:
-            try:
-                with open(os.path.join(r.dir, "run.json")) as f:
-                    commits.add(json.load(f)["provenance"]["build"]["git_commit"])
-            except (OSError, ValueError, KeyError, TypeError):
-                pass
+    commits = {((r.run.get("provenance") or {}).get("build") or {}).get("git_commit") for c in cells for r in c.runs}
+    commits.discard(None)
     if len(commits) > 1:
         mr.die(f"the cells ran on {len(commits)} builds ({', '.join(sorted(commits))}): not one study")
     return commits.pop() if commits else None
