@@ -37,7 +37,8 @@ cp "$src/experiments/scenes/stretched-box.json" "$tmp/gone.json"
 # The 30 s limit leaves the ok cell (about 1 s alone) room on a loaded machine
 # (at 5 s it timed out in CI while other tests shared the cores); the slow
 # cell (drop at scale 1, 600 frames) needs about 2 minutes alone, so it
-# reaches the limit on any machine.
+# reaches the limit on any machine; its kill is checked against 30-45 s
+# (the runner needs only to wake, however loaded the machine).
 cat >"$tmp/m.json" <<'EOF'
 {"name": "statuses",
  "defaults": {"threads": 1, "solver": "pn-pcg"},
@@ -73,7 +74,7 @@ check "ok cell" test "$(col "$csv" status "$id_ok")" = ok
 check "crashed cell: status" test "$(col "$csv" status "$id_crash")" = crashed
 check "crashed cell: exit -11 (SIGSEGV)" test "$(col "$csv" exit "$id_crash")" = -11
 check "timeout cell" test "$(col "$csv" status "$id_slow")" = timeout
-check "timeout cell: killed near its limit" python3 -c "import sys; t=float(sys.argv[1]); sys.exit(not 30 <= t < 36)" \
+check "timeout cell: killed near its limit" python3 -c "import sys; t=float(sys.argv[1]); sys.exit(not 30 <= t < 45)" \
   "$(col "$csv" elapsed_s "$id_slow")"
 check "timeout cell: frames done before it are counted" test "$(col "$csv" frames "$id_slow")" -ge 1
 check "bad-input cell: status and exit 2" test "$(col "$csv" status "$id_gone"),$(col "$csv" exit "$id_gone")" = bad-input,2
