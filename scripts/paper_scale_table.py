@@ -3,6 +3,7 @@
 run of experiments/matrices/paper-scale.json:
 
     python3 scripts/paper_scale_table.py results/paper-scale > results/paper-scale/table.md
+    python3 scripts/paper_scale_table.py PART_DIR PART_DIR ... > table.md
     python3 scripts/paper_scale_table.py --rerun-bounds OLD_DIR NEW_DIR MPMBENCH
 
 Each scene's whole animation is simulated once by HOT (the reference run,
@@ -25,6 +26,12 @@ same checkpoints and sampled frames, stopped by --max-run-seconds, with its
 the sample, so HOT's speedup over it is at least those seconds over HOT's
 slowest run, and the table prints it as such. --rerun-bounds runs the
 bounds of a study again into a rerun of it (scripts/reproduce.sh does).
+
+Timings from two machines are never one study: every run of a folder must
+name one CPU model (and one build), or the script stops. A matrix run in
+parts on different machines, each scene wholly on one, is given as several
+folders: one table, each scene's row naming its machine, and the summary
+(geometric means, ranks) once per machine, never pooled.
 """
 import glob
 import json
@@ -77,6 +84,7 @@ class Bound:
         self.limit = (run.get("limits") or {}).get("max_run_seconds") or 0.0
         self.overrides = run.get("overrides") or {}
         self.commit = ((run.get("provenance") or {}).get("build") or {}).get("git_commit")
+        self.machine = run_machine(run)
         self.busy = bool((run.get("machine_load") or {}).get("machine_busy"))
         ran = [f for f in frames if int(mr.number(f.get("steps"), 0)) > 0]  # not the 0-step row of the frame after
         self.frame_time = {int(mr.number(f.get("frame"), -1)): mr.number(f.get("wall_s"), 0.0) for f in ran}
@@ -93,16 +101,17 @@ class Bound:
         # the frames before the stop must have met eps: else the seconds are not those of reaching it
         self.failed = [f.get("frame") for f in frames if not stopped(f) and f.get("status") != "converged"]
 
-    def check(self, hot, study_commit):
+    def check(self, hot, study_commit, study_machine):
         """Dies (one line, exit 2) unless the run times the same states as the study's cells of its
-        scene: the reference's checkpoints, the sampled frames, eps, scale, threads and build; and
+        scene: the reference's checkpoints, the sampled frames, eps, scale, threads, build and
+        machine; and
         unless its time limit cut it short (a whole run is a cell of the matrix, not a bound)."""
         hot_overrides = hot.run.get("overrides") or {}
         want = {"sample_frames": hot.row.get("sample_frames"), "eps": mr.number(hot.row.get("eps")),
                 "scale": mr.number(hot.row.get("scale")), "threads": int(mr.number(hot.row.get("threads"), 0)),
-                "git_commit": study_commit, "overrides": hot_overrides}
+                "git_commit": study_commit, "cpu_model": study_machine, "overrides": hot_overrides}
         got = {"sample_frames": self.sample_frames, "eps": self.eps, "scale": self.scale, "threads": self.threads,
-               "git_commit": self.commit, "overrides": self.overrides}
+               "git_commit": self.commit, "cpu_model": self.machine, "overrides": self.overrides}
         for k, v in want.items():
             if got[k] != v:
                 mr.die(f"{self.path}/run.json: {k} {got[k]!r}, but the study's {self.scene} cells ran with {v!r}")
@@ -131,6 +140,21 @@ def study_commit(cells):
     return commits.pop() if commits else None
 
 
+def run_machine(run):
+    """The CPU model a run.json's provenance names (None when it names none)."""
+    return (run.get("provenance") or {}).get("cpu_model")
+
+
+def study_machine(cells):
+    """The CPU every run of these cells ran on; dies when there are several: timings from two
+    machines are not one study (run each machine's scenes into a study of its own)."""
+    models = {run_machine(r.run) for c in cells for r in c.runs}
+    models.discard(None)
+    if len(models) > 1:
+        mr.die(f"the cells ran on {len(models)} machines ({', '.join(sorted(models))}): not one study")
+    return models.pop() if models else None
+
+
 def excluded(meta, scene, solver):
     """Does an exclude rule of the matrix (one of scene and solver only) drop this pair?"""
     def hits(rule, key, value):
@@ -146,6 +170,7 @@ def load_bounds(d, timed):
     root = os.path.join(d, "bounds")
     names = sorted(os.listdir(root)) if os.path.isdir(root) else []
     commit = study_commit(timed.values())
+    machine = study_machine(timed.values())
     out = {}
     for name in names:
         b = Bound(os.path.join(root, name))
@@ -154,7 +179,7 @@ def load_bounds(d, timed):
             mr.die(f"{b.path}/run.json: scene {b.scene!r} has no timed {HOT} cell in {d}")
         if (b.scene, b.solver) in timed:
             mr.die(f"{b.path}/run.json: {b.scene}/{b.solver} is also a timed cell of the study: one or the other")
-        b.check(hot, commit)
+        b.check(hot, commit, machine)
         out[(b.scene, b.solver)] = b
     return out
 
@@ -201,66 +226,136 @@ def span(xs):
     return f"{mr.fmt(min(xs))}-{mr.fmt(max(xs))}"
 
 
-def main(d):
-    study = load(d)
-    meta, scenes, solvers, timed, refs = study
-    others = [s for s in solvers if s != HOT]
-    speed = hot_speedups(study)
-    paper_set = [so for so in solvers if so == HOT or so in PAPER_TOTAL]
-    wins = fastest(study, paper_set)
-    bounds = load_bounds(d, timed)
-    unranked = {}  # scene -> why a bound leaves its fastest open
-    for (sc, so), b in bounds.items():
-        if so in paper_set and wins.get(sc):
-            best = timed[(sc, wins[sc][0])]
-            if not b.spent / len(best.timed) > best.hi or b.busy or b.failed:
-                unranked[sc] = f"{so}'s bound does not show it slower than {best.solver}"
-                wins[sc] = None
-    done = [sc for sc in scenes if all((sc, so) in timed or (sc, so) in bounds for so in solvers)]
-    missing = [sc for sc in scenes if sc not in done and not all(
-        (sc, so) in timed or excluded(meta, sc, so) for so in solvers)]
-    unbounded = [f"{sc}/{so}" for sc in scenes for so in solvers
-                 if sc not in done and sc not in missing and (sc, so) not in timed and (sc, so) not in bounds]
+class Part:
+    """One study folder of the matrix (one build, one machine): its cells, bounds and what they show.
+    dir, machine, commit; study: what load returns; bounds; speed: hot_speedups; wins, unranked;
+    done: scenes with every solver timed or bounded; missing, unbounded: what is left."""
 
-    print("# HOT supplement Table 1 at the paper's scale, like for like\n")
-    ranked = [sc for sc in done if wins.get(sc)]
-    alone = [sc for sc in ranked if wins[sc] == [HOT]]
-    tied = [sc for sc in ranked if HOT in wins[sc] and len(wins[sc]) > 1]
-    lost = [sc for sc in ranked if HOT not in wins[sc]]
-    print(f"- Among the paper's solvers ({', '.join(paper_set)}) HOT was the fastest on {len(alone)} of "
+    def __init__(self, d):
+        self.dir = d
+        self.study = load(d)
+        meta, scenes, solvers, timed, refs = self.study
+        ran = list(timed.values()) + list(refs.values())
+        self.machine, self.commit = study_machine(ran), study_commit(ran)
+        self.present = {c.row["scene"] for c in ran}
+        self.speed = hot_speedups(self.study)
+        self.paper_set = [so for so in solvers if so == HOT or so in PAPER_TOTAL]
+        self.wins = fastest(self.study, self.paper_set)
+        self.bounds = load_bounds(d, timed)
+        self.unranked = {}  # scene -> why a bound leaves its fastest open
+        for (sc, so), b in self.bounds.items():
+            if so in self.paper_set and self.wins.get(sc):
+                best = timed[(sc, self.wins[sc][0])]
+                if not b.spent / len(best.timed) > best.hi or b.busy or b.failed:
+                    self.unranked[sc] = f"{so}'s bound does not show it slower than {best.solver}"
+                    self.wins[sc] = None
+        self.done = [sc for sc in scenes if all((sc, so) in timed or (sc, so) in self.bounds for so in solvers)]
+        self.missing = [sc for sc in scenes if sc not in self.done and not all(
+            (sc, so) in timed or excluded(meta, sc, so) for so in solvers)]
+        self.unbounded = [f"{sc}/{so}" for sc in scenes for so in solvers
+                          if sc not in self.done and sc not in self.missing and (sc, so) not in timed
+                          and (sc, so) not in self.bounds]
+
+
+def check_parts(parts):
+    """Several parts make one table only when they ran one matrix on one build and no scene is in two
+    of them (a scene's reference and cells come from one machine); dies otherwise."""
+    first = parts[0]
+    for p in parts[1:]:
+        for what, get in (("matrix", lambda q: q.study[0].get("name")), ("solvers", lambda q: q.study[2]),
+                          ("build", lambda q: q.commit)):
+            if get(p) != get(first):
+                mr.die(f"{p.dir}: {what} {get(p)!r}, but {first.dir} has {get(first)!r}: not parts of one study")
+    seen = {}
+    for p in parts:
+        for sc in sorted(p.present):
+            if sc in seen:
+                mr.die(f"{p.dir}: scene {sc!r} is also in {seen[sc]}: a scene's runs come from one machine")
+            seen[sc] = p.dir
+
+
+def summary(p, solvers):
+    """The bullets of one part: HOT's rank among the paper's solvers, and its speedup over each."""
+    _, _, _, timed, _ = p.study
+    ranked = [sc for sc in p.done if p.wins.get(sc)]
+    alone = [sc for sc in ranked if p.wins[sc] == [HOT]]
+    tied = [sc for sc in ranked if HOT in p.wins[sc] and len(p.wins[sc]) > 1]
+    lost = [sc for sc in ranked if HOT not in p.wins[sc]]
+    print(f"- Among the paper's solvers ({', '.join(p.paper_set)}) HOT was the fastest on {len(alone)} of "
           f"{len(ranked)} scenes "
           f"by more than the spread of the runs, tied for the fastest on {len(tied)}"
           + (f" ({', '.join(tied)})" if tied else "")
-          + (f"; slower on {', '.join(f'{sc} (fastest: {wins[sc][0]})' for sc in lost)}" if lost else "")
-          + (f"; unranked: {'; '.join(f'{sc} ({why})' for sc, why in unranked.items())}" if unranked else "")
+          + (f"; slower on {', '.join(f'{sc} (fastest: {p.wins[sc][0]})' for sc in lost)}" if lost else "")
+          + (f"; unranked: {'; '.join(f'{sc} ({why})' for sc, why in p.unranked.items())}" if p.unranked else "")
           + ". The paper: HOT the fastest of these on all but two of its ten scenes.")
-    for so in others:
-        sp = speed.get(so, {})
-        bounded = [(sc, b) for (sc, o), b in bounds.items() if o == so and sc in done and not b.busy]
+    for so in solvers:
+        if so == HOT:
+            continue
+        sp = p.speed.get(so, {})
+        bounded = [(sc, b) for (sc, o), b in p.bounds.items() if o == so and sc in p.done and not b.busy]
         if not sp and not bounded:
             continue
         tot = [s.total for s in sp.values()]
         per = [s.per for s in sp.values() if s.per]
         paper = f"; the paper: {PAPER_TOTAL[so]}x" if so in PAPER_TOTAL else "; the paper has no such solver"
-        line = (f"- HOT against {so}: {mr.geomean(tot):.2f}x as fast in total (geometric mean over {len(tot)} "
-                f"scenes, {span(tot)}x), largest per-frame ratio {span(per)}x" if tot else f"- HOT against {so}:")
+        if len(tot) > 1:
+            line = (f"- HOT against {so}: {mr.geomean(tot):.2f}x as fast in total (geometric mean over {len(tot)} "
+                    f"scenes, {span(tot)}x), largest per-frame ratio {span(per)}x")
+        elif tot:
+            line = (f"- HOT against {so}: {mr.fmt(tot[0])}x as fast in total (one scene, {next(iter(sp))}), "
+                    f"largest per-frame ratio {span(per) if len(per) != 1 else mr.fmt(per[0])}x")
+        else:
+            line = f"- HOT against {so}:"
         for sc, b in bounded:
             total, fr = bound_speedups(b, timed[(sc, HOT)])
             line += (f"{';' if tot else ''} on {sc} at least {mr.fmt(total)}x in total and {mr.fmt(fr)}x "
                      f"on a frame ({b.text()})")
         print(line + f"{paper}.")
-    if missing:
-        print(f"- Not run yet: {', '.join(missing)} (`matrix run` resumes).")
-    if unbounded:
-        print(f"- Excluded from the matrix and not bounded yet: {', '.join(unbounded)} (a run stopped by "
+    if p.unbounded:
+        print(f"- Excluded from the matrix and not bounded yet: {', '.join(p.unbounded)} (a run stopped by "
               "--max-run-seconds into DIR/bounds/, as this script's help says).")
+
+
+def main(dirs):
+    parts = [Part(d) for d in dirs]
+    check_parts(parts)
+    _, scenes, solvers, _, _ = parts[0].study
+    others = [s for s in solvers if s != HOT]
+    owner = {sc: p for p in parts for sc in p.done}  # the part that holds each finished scene
+    rows = [(sc, owner[sc]) for sc in scenes if sc in owner]
+    several = len(parts) > 1
+
+    def where(p):  # the machine column, when the table joins several parts
+        return f" {p.machine or '?'} |" if several else ""
+
+    print("# HOT supplement Table 1 at the paper's scale, like for like\n")
+    build = (parts[0].commit or "?")[:7]
+    if several:
+        print(f"Build {build}, in {len(parts)} parts that ran on different machines. Each scene's runs "
+              "all come from one machine, so every ratio below is measured on one machine; no summary "
+              "pools two machines:\n")
+        for p in parts:
+            print(f"- {p.dir}: {p.machine or '?'}; scenes {', '.join(sc for sc in scenes if sc in p.present)}")
+        print()
+    else:
+        print(f"Build {build}, every run on one machine ({parts[0].machine or '?'}).\n")
+    for p in parts:
+        if several:
+            print(f"On {p.machine or '?'} ({p.dir}):\n")
+        summary(p, solvers)
+        if several:
+            print()
+    missing = [sc for sc in scenes if all(sc in p.missing for p in parts)]
+    if missing:
+        print(f"{'' if several else chr(10)}- Not run yet: {', '.join(missing)} (`matrix run` resumes).".lstrip("\n"))
 
     print("\nHOT's speedup over each solver, total over the sampled frames (median of the runs; range "
           "over the runs in brackets) and the largest per-frame ratio of the sampled frames after the "
           "slash; `~` where the ranges overlap (within the noise):\n")
-    print("| scene | particles | frames timed | " + " | ".join(others) + " |")
-    print("|---|---|---|" + "---|" * len(others))
-    for sc in done:
+    print("| scene |" + (" machine |" if several else "") + " particles | frames timed | " + " | ".join(others) + " |")
+    print("|---|" + ("---|" if several else "") + "---|---|" + "---|" * len(others))
+    for sc, p in rows:
+        timed, bounds = p.study[3], p.bounds
         h = timed[(sc, HOT)]
         frames = ", ".join(str(k) for k in sorted(h.timed))
         cols = []
@@ -272,15 +367,16 @@ def main(d):
                 continue
             sp = mr.Speedup(h, timed[(sc, so)])
             cols.append("-" if sp.total is None else f"{sp.text()} / {mr.fmt(sp.per)}")
-        print(f"| {sc} | {int(mr.number(h.row.get('particles'), 0)):,} | {frames} | " + " | ".join(cols) + " |")
+        print(f"| {sc} |{where(p)} {int(mr.number(h.row.get('particles'), 0)):,} | {frames} | " + " | ".join(cols) + " |")
 
     print("\nSeconds per sampled frame (median of the runs); iterations over the sampled frames in the first "
           "run, outer (Newton or L-BFGS) / linear (PN's PCG) / inner (inside the inverse approximation: "
           "the coarsest-level PCG of a geometric V-cycle, LBFGS-H's PCG; 0 where none is counted); "
           "peak resident memory in MB (the largest over the runs):\n")
-    print("| scene | " + " | ".join(solvers) + " |")
-    print("|---|" + "---|" * len(solvers))
-    for sc in done:
+    print("| scene |" + (" machine |" if several else "") + " " + " | ".join(solvers) + " |")
+    print("|---|" + ("---|" if several else "") + "---|" * len(solvers))
+    for sc, p in rows:
+        timed, bounds = p.study[3], p.bounds
         cols = []
         for so in solvers:
             if (sc, so) in bounds:
@@ -293,15 +389,16 @@ def main(d):
             its = f"{c.outer} / {c.linear} / {c.row.get('inner_iters') or '-'}"
             mb = max((mr.number(r.row.get("peak_rss_mb"), 0.0) for r in c.runs), default=0.0)
             cols.append(f"{mr.fmt(c.s_per_frame)}{marks}; {its}; {mb:.0f} MB")
-        print(f"| {sc} | " + " | ".join(cols) + " |")
+        print(f"| {sc} |{where(p)} " + " | ".join(cols) + " |")
 
     print("\nHow far the sampled frames stand for the whole animation: each scene's reference run simulated "
           "every frame once (and wrote the checkpoints); its seconds per frame over all frames beside the "
           "same solver's median over the sampled frames:\n")
-    print("| scene | reference solver | frames | steps | whole animation, s/frame | slowest frame, s | "
-          "sampled, s/frame | sampled / whole | peak MB |")
-    print("|---|---|---|---|---|---|---|---|---|")
-    for sc in done:
+    print("| scene |" + (" machine |" if several else "") + " reference solver | frames | steps | whole animation, "
+          "s/frame | slowest frame, s | sampled, s/frame | sampled / whole | peak MB |")
+    print("|---|" + ("---|" if several else "") + "---|---|---|---|---|---|---|---|")
+    for sc, p in rows:
+        timed, refs = p.study[3], p.study[4]
         ref = refs.get(sc)
         if ref is None or (sc, ref.solver) not in timed:
             continue
@@ -309,26 +406,33 @@ def main(d):
         slowest = max(ref.frame_time.values()) if ref.frame_time else float("nan")
         whole = ref.s_per_frame
         busy = " busy" if ref.busy else ""
-        print(f"| {sc} | {ref.solver} | {len(ref.frame_time)} | {ref.row.get('steps', '-')} | {mr.fmt(whole)}{busy} | "
-              f"{mr.fmt(slowest)} | {mr.fmt(same.s_per_frame)} | "
+        print(f"| {sc} |{where(p)} {ref.solver} | {len(ref.frame_time)} | {ref.row.get('steps', '-')} | "
+              f"{mr.fmt(whole)}{busy} | {mr.fmt(slowest)} | {mr.fmt(same.s_per_frame)} | "
               f"{mr.fmt(same.s_per_frame / whole if whole else float('nan'))} | "
               f"{mr.number(ref.row.get('peak_rss_mb'), 0.0):.0f} |")
-    if bounds:
+    bounded = [(sc, so, b, p) for p in parts for (sc, so), b in sorted(p.bounds.items())]
+    if bounded:
         print("\nBounds: solvers a scene could not time three times, each run once from the same checkpoints "
               "and stopped by a time limit; seconds per sampled frame up to the stop (the last one cut short), "
               "against HOT's slowest run on the same frame:\n")
-        print("| scene | solver | stopped | seconds per frame | HOT's slowest, s |")
-        print("|---|---|---|---|---|")
-        for (sc, so), b in sorted(bounds.items()):
-            hot = timed[(sc, HOT)]
+        print("| scene |" + (" machine |" if several else "") + " solver | stopped | seconds per frame | "
+              "HOT's slowest, s |")
+        print("|---|" + ("---|" if several else "") + "---|---|---|---|")
+        for sc, so, b, p in bounded:
+            hot = p.study[3][(sc, HOT)]
             secs = ", ".join(f"{k}: {mr.fmt(t)}" for k, t in sorted(b.frame_time.items()))
             slow = ", ".join(f"{k}: {mr.fmt(max(r.timed.get(k, float('nan')) for r in hot.runs))}"
                              for k in sorted(hot.timed))
-            print(f"| {sc} | {so} | {b.text()} | {secs} | {slow} |")
-    runs = [r for c in timed.values() for r in c.runs]
-    print(f"\n{len(runs)} timed runs, {sum(r.busy for r in runs)} on a busy machine, "
-          f"{sum(1 for r in runs if r.status != 'ok')} not ok; "
-          f"median runs a cell {statistics.median(len(c.runs) for c in timed.values()):.0f}.")
+            print(f"| {sc} |{where(p)} {so} | {b.text()} | {secs} | {slow} |")
+    print()
+    for p in parts:
+        timed = p.study[3]
+        runs = [r for c in timed.values() for r in c.runs]
+        if not runs:
+            continue
+        print(f"{p.dir + ': ' if several else ''}{len(runs)} timed runs, {sum(r.busy for r in runs)} on a busy "
+              f"machine, {sum(1 for r in runs if r.status != 'ok')} not ok; "
+              f"median runs a cell {statistics.median(len(c.runs) for c in timed.values()):.0f}.")
 
 
 def rerun_bounds(old, new, binary):
@@ -357,8 +461,9 @@ def rerun_bounds(old, new, binary):
 if __name__ == "__main__":
     if len(sys.argv) == 5 and sys.argv[1] == "--rerun-bounds":
         rerun_bounds(*sys.argv[2:])
-    elif len(sys.argv) == 2:
-        main(sys.argv[1])
+    elif len(sys.argv) >= 2 and not sys.argv[1].startswith("-"):
+        main(sys.argv[1:])
     else:
-        print("usage: paper_scale_table.py RESULTS_DIR | --rerun-bounds OLD_DIR NEW_DIR MPMBENCH", file=sys.stderr)
+        print("usage: paper_scale_table.py RESULTS_DIR [RESULTS_DIR ...] | --rerun-bounds OLD_DIR NEW_DIR MPMBENCH",
+              file=sys.stderr)
         sys.exit(2)

@@ -8,7 +8,9 @@
 # says which frames were sampled; scripts/paper_scale_table.py computes
 # HOT's speedups from the sampled frames, and a lower bound on them from a
 # run the matrix excludes, stopped by its time limit (DIR/bounds/NAME/),
-# refusing one that timed other states or was not stopped; other scenes run as before; a second
+# refusing one that timed other states or was not stopped, and a study whose runs
+# come from two machines, joining parts from two machines a scene each;
+# scripts/reproduce.sh remakes a study made in parts whole; other scenes run as before; a second
 # `matrix run` has nothing to do; the sampled frames are part of the ids;
 # a bad list, or first_timed_frame beside sample_frames, is a one-line
 # error, exit 2.
@@ -133,7 +135,22 @@ python3 "$src/scripts/paper_scale_table.py" "$tmp/r" >/dev/null 2>"$tmp/berr1"
 rc=$?
 check "a bound of other frames: exit 2, one line ($(head -c 200 "$tmp/berr1"))" \
   bash -c "test $rc -eq 2 && test \$(wc -l <'$tmp/berr1') -eq 1 && grep -q \"sauce-lbfgs-h/run.json: sample_frames '1,4', but the study's sauce cells ran with '1,4,6'\" '$tmp/berr1'"
+# timings from two machines are not one study: a bound, or a cell, run on another CPU is refused
+rm -r "$bound" && cp -r "$tmp/bound.ok" "$bound"
+sed -i 's/"cpu_model": *"[^"]*"/"cpu_model": "Other CPU"/' "$bound/run.json"
+python3 "$src/scripts/paper_scale_table.py" "$tmp/r" >/dev/null 2>"$tmp/berr3"
+rc=$?
+check "a bound from another machine: exit 2, one line ($(head -c 200 "$tmp/berr3"))" \
+  bash -c "test $rc -eq 2 && test \$(wc -l <'$tmp/berr3') -eq 1 && grep -q \"sauce-lbfgs-h/run.json: cpu_model 'Other CPU', but the study's sauce cells ran with\" '$tmp/berr3'"
 rm -r "$bound"
+pn=$(awk -F, '$2 == "sauce" && $3 == "pn-pcg" && $10 == "cell" {print $1}' "$tmp/r/cells.csv")
+cp "$tmp/r/cells/$pn/run.json" "$tmp/pn-run.json"
+sed -i 's/"cpu_model": *"[^"]*"/"cpu_model": "Other CPU"/' "$tmp/r/cells/$pn/run.json"
+python3 "$src/scripts/paper_scale_table.py" "$tmp/r" >/dev/null 2>"$tmp/merr"
+rc=$?
+check "a cell from another machine: exit 2, one line ($(head -c 200 "$tmp/merr"))" \
+  bash -c "test $rc -eq 2 && test \$(wc -l <'$tmp/merr') -eq 1 && grep -q 'the cells ran on 2 machines (.*Other CPU.*): not one study' '$tmp/merr'"
+cp "$tmp/pn-run.json" "$tmp/r/cells/$pn/run.json"
 "$bin" run --scene sauce --solver lbfgs-h --scale 5 --threads 2 --sample-from "$tmp/r/cells/$ref/checkpoints" \
   --sample-frames 1,4,6 --quiet --out "$bound" >"$tmp/whole.txt" 2>&1
 python3 "$src/scripts/paper_scale_table.py" "$tmp/r" >/dev/null 2>"$tmp/berr2"
@@ -152,6 +169,63 @@ bar3_ids() { awk '$3 ~ /^bar3\// {print $1}' "$1" | sort; }
 check "other sampled frames: every sauce id changes ($(sauce_ids "$tmp/dry2.txt" | wc -l) cells)" \
   test -z "$(comm -12 <(sauce_ids "$tmp/dry1.txt") <(sauce_ids "$tmp/dry2.txt"))" -a "$(sauce_ids "$tmp/dry2.txt" | wc -l)" -eq 3
 check "and no bar3 id" test "$(bar3_ids "$tmp/dry1.txt")" = "$(bar3_ids "$tmp/dry2.txt")"
+
+# a table of two parts, one machine each (here a copy of the study split by scene, its second part
+# relabelled as another CPU): each scene's row names its machine, each machine its own summary;
+# a scene in both parts is refused
+python3 - "$tmp/r" "$tmp/pa" "$tmp/pb" <<'PY'
+import csv, glob, re, shutil, sys
+src, pa, pb = sys.argv[1:]
+for d, drop in ((pa, "bar3"), (pb, "sauce")):
+    shutil.copytree(src, d)
+    rows = list(csv.DictReader(open(f"{d}/cells.csv")))
+    with open(f"{d}/cells.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(r for r in rows if r["scene"] != drop)
+for run in glob.glob(f"{pb}/cells/*/run.json"):
+    text = open(run).read()
+    open(run, "w").write(re.sub(r'"cpu_model": *"[^"]*"', '"cpu_model": "Other CPU"', text))
+PY
+python3 "$src/scripts/paper_scale_table.py" "$tmp/pa" "$tmp/pb" >"$tmp/parts.md" 2>"$tmp/parts.err"
+rc=$?
+check "a table of two parts: exit $rc ($(head -c 200 "$tmp/parts.err")), a machine a row and a summary a machine" \
+  bash -c "test $rc -eq 0 && grep -q '^| sauce | [^|]* | [0-9,]* | 1, 4, 6 | ' '$tmp/parts.md' && ! grep -q '^| sauce | Other CPU |' '$tmp/parts.md' \
+    && grep -q '^| bar3 | Other CPU | ' '$tmp/parts.md' && grep -q '^On Other CPU ($tmp/pb):' '$tmp/parts.md' \
+    && test \$(grep -c '^On ' '$tmp/parts.md') -eq 2"
+python3 "$src/scripts/paper_scale_table.py" "$tmp/pa" "$tmp/r" >/dev/null 2>"$tmp/parts2.err"
+rc=$?
+check "a scene in two parts: exit 2 ($(head -c 200 "$tmp/parts2.err"))" \
+  bash -c "test $rc -eq 2 && grep -q \"$tmp/r: scene 'sauce' is also in $tmp/pa: a scene's runs come from one machine\" '$tmp/parts2.err'"
+
+# scripts/reproduce.sh remakes a study made part by part (every invocation with --only) whole: the
+# committed cells' scenes and solvers, a scene with every solver as scene/*, the globs reaching
+# mpmbench unquoted; and everything when one invocation ran every cell
+cp -r "$tmp/r" "$tmp/parts"
+python3 - "$tmp/parts/provenance.json" <<'PY'
+import json, sys
+p = json.load(open(sys.argv[1]))
+inv = p["invocations"][0]
+p["invocations"] = [dict(inv, options=dict(inv["options"], only=o)) for o in (["sauce/*"], ["bar3/*"], ["1234abcd"])]
+json.dump(p, open(sys.argv[1], "w"))
+PY
+MPMBENCH=$bin bash "$src/scripts/reproduce.sh" "$tmp/parts" --dry-run >"$tmp/repro.txt" 2>&1
+rc=$?
+cmd=$(grep "matrix run" "$tmp/repro.txt" | sed 's/^reproduce.sh: //')
+check "reproduce.sh --dry-run on a study made in parts: exit $rc, the committed pairs ($cmd)" \
+  bash -c "test $rc -eq 0 && grep -qF -- '--only sauce/pn-pcg --only sauce/hot --only bar3/\\* --out $tmp/parts.new' '$tmp/repro.txt'"
+eval "$cmd --dry-run" >"$tmp/repro-dry.txt" 2>&1
+check "its command lists the committed cells, no more ($(head -1 "$tmp/repro-dry.txt"))" \
+  test "$(grep -c '  todo  ' "$tmp/repro-dry.txt")" -eq "$(($(wc -l <"$tmp/r/cells.csv") - 1))"
+python3 - "$tmp/parts/provenance.json" <<'PY'
+import json, sys
+p = json.load(open(sys.argv[1]))
+p["invocations"][1]["options"]["only"] = []
+json.dump(p, open(sys.argv[1], "w"))
+PY
+MPMBENCH=$bin bash "$src/scripts/reproduce.sh" "$tmp/parts" --dry-run >"$tmp/repro2.txt" 2>&1
+check "and the whole matrix after an invocation without --only" \
+  bash -c "grep -q 'matrix run $tmp/m.json --out $tmp/parts.new' '$tmp/repro2.txt' && ! grep -q -- '--only' '$tmp/repro2.txt'"
 
 sed 's/"1,4,6"/"4,1"/' "$tmp/m.json" >"$tmp/bad.json"
 expect_input_error "^mpmbench: error: .*bad.json: scenes.sauce.reference.sample_frames: --sample-frames '4,1': frame 1 after 4" matrix run "$tmp/bad.json" --out "$tmp/b" --dry-run
