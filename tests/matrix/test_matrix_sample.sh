@@ -143,7 +143,8 @@ rc=$?
 check "a bound from another machine: exit 2, one line ($(head -c 200 "$tmp/berr3"))" \
   bash -c "test $rc -eq 2 && test \$(wc -l <'$tmp/berr3') -eq 1 && grep -q \"sauce-lbfgs-h/run.json: cpu_model 'Other CPU', but the study's sauce cells ran with\" '$tmp/berr3'"
 rm -r "$bound"
-pn=$(awk -F, '$2 == "sauce" && $3 == "pn-pcg" && $10 == "cell" {print $1}' "$tmp/r/cells.csv")
+pn=$(python3 -c 'import csv, sys; print(next(r["id"] for r in csv.DictReader(open(sys.argv[1]))
+  if (r["scene"], r["solver"], r["role"]) == ("sauce", "pn-pcg", "cell")))' "$tmp/r/cells.csv")
 cp "$tmp/r/cells/$pn/run.json" "$tmp/pn-run.json"
 sed -i 's/"cpu_model": *"[^"]*"/"cpu_model": "Other CPU"/' "$tmp/r/cells/$pn/run.json"
 python3 "$src/scripts/paper_scale_table.py" "$tmp/r" >/dev/null 2>"$tmp/merr"
@@ -170,14 +171,16 @@ check "other sampled frames: every sauce id changes ($(sauce_ids "$tmp/dry2.txt"
   test -z "$(comm -12 <(sauce_ids "$tmp/dry1.txt") <(sauce_ids "$tmp/dry2.txt"))" -a "$(sauce_ids "$tmp/dry2.txt" | wc -l)" -eq 3
 check "and no bar3 id" test "$(bar3_ids "$tmp/dry1.txt")" = "$(bar3_ids "$tmp/dry2.txt")"
 
-# a table of two parts, one machine each (here a copy of the study split by scene, its second part
-# relabelled as another CPU): each scene's row names its machine, each machine its own summary;
-# a scene in both parts is refused
-python3 - "$tmp/r" "$tmp/pa" "$tmp/pb" <<'PY'
+# a table of two parts, one machine each (here a copy of the study with its bound, split by scene,
+# its second part relabelled as another CPU): each scene's row names its machine, each machine its
+# own summary; a scene in both parts is refused
+python3 - "$tmp/r" "$tmp/pa" "$tmp/pb" "$tmp/bound.ok" <<'PY'
 import csv, glob, re, shutil, sys
-src, pa, pb = sys.argv[1:]
+src, pa, pb, bound = sys.argv[1:]
 for d, drop in ((pa, "bar3"), (pb, "sauce")):
     shutil.copytree(src, d)
+    if drop == "bar3":
+        shutil.copytree(bound, f"{d}/bounds/sauce-lbfgs-h")
     rows = list(csv.DictReader(open(f"{d}/cells.csv")))
     with open(f"{d}/cells.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0]))
