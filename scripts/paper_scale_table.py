@@ -83,8 +83,7 @@ class Bound:
         self.sample_from, self.sample_frames = ck.get("sample_from") or "", ck.get("sample_frames") or ""
         self.limit = (run.get("limits") or {}).get("max_run_seconds") or 0.0
         self.overrides = run.get("overrides") or {}
-        self.commit = ((run.get("provenance") or {}).get("build") or {}).get("git_commit")
-        self.machine = run_machine(run)
+        self.commit, self.machine = run_commit(run), run_machine(run)
         self.busy = bool((run.get("machine_load") or {}).get("machine_busy"))
         ran = [f for f in frames if int(mr.number(f.get("steps"), 0)) > 0]  # not the 0-step row of the frame after
         self.frame_time = {int(mr.number(f.get("frame"), -1)): mr.number(f.get("wall_s"), 0.0) for f in ran}
@@ -131,13 +130,9 @@ class Bound:
                                                      if self.failed else ""))
 
 
-def study_commit(cells):
-    """The build every timed cell ran (run.json provenance); dies when there are several."""
-    commits = {((r.run.get("provenance") or {}).get("build") or {}).get("git_commit") for c in cells for r in c.runs}
-    commits.discard(None)
-    if len(commits) > 1:
-        mr.die(f"the cells ran on {len(commits)} builds ({', '.join(sorted(commits))}): not one study")
-    return commits.pop() if commits else None
+def run_commit(run):
+    """The build a run.json's provenance names (None when it names none)."""
+    return ((run.get("provenance") or {}).get("build") or {}).get("git_commit")
 
 
 def run_machine(run):
@@ -145,14 +140,25 @@ def run_machine(run):
     return (run.get("provenance") or {}).get("cpu_model")
 
 
+def study_one(cells, get, what):
+    """The one value get(run.json) of every run of these cells (None when none names it); dies when
+    there are several: timings from two builds, or two machines, are not one study."""
+    values = {get(r.run) for c in cells for r in c.runs}
+    values.discard(None)
+    if len(values) > 1:
+        mr.die(f"the cells ran on {len(values)} {what} ({', '.join(sorted(values))}): not one study")
+    return values.pop() if values else None
+
+
+def study_commit(cells):
+    """The build every run of these cells ran; dies when there are several."""
+    return study_one(cells, run_commit, "builds")
+
+
 def study_machine(cells):
-    """The CPU every run of these cells ran on; dies when there are several: timings from two
-    machines are not one study (run each machine's scenes into a study of its own)."""
-    models = {run_machine(r.run) for c in cells for r in c.runs}
-    models.discard(None)
-    if len(models) > 1:
-        mr.die(f"the cells ran on {len(models)} machines ({', '.join(sorted(models))}): not one study")
-    return models.pop() if models else None
+    """The CPU every run of these cells ran on; dies when there are several (run each machine's
+    scenes into a folder of its own: several folders make one table as parts)."""
+    return study_one(cells, run_machine, "machines")
 
 
 def excluded(meta, scene, solver):
@@ -347,7 +353,7 @@ def main(dirs):
             print()
     missing = [sc for sc in scenes if all(sc in p.missing for p in parts)]
     if missing:
-        print(f"{'' if several else chr(10)}- Not run yet: {', '.join(missing)} (`matrix run` resumes).".lstrip("\n"))
+        print(f"- Not run yet: {', '.join(missing)} (`matrix run` resumes).")
 
     print("\nHOT's speedup over each solver, total over the sampled frames (median of the runs; range "
           "over the runs in brackets) and the largest per-frame ratio of the sampled frames after the "
