@@ -58,6 +58,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import setting_table  # noqa: E402
 import study_status  # noqa: E402
 import matrix_report  # noqa: E402
+import paper_scale_table  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RESULTS = os.path.join(ROOT, "results")
@@ -517,6 +518,56 @@ def paper_particles():
     return f"{grouped(min(parts))} to {grouped(max(parts))}"
 
 
+# The like-for-like Table 1 runs in two parts, each scene wholly on one machine; a part's numbers are
+# never pooled with the other's (scripts/paper_scale_table.py), so every key names its part. While the
+# parts are under way (results/paper-scale*.new, issue 28) no page quotes these keys.
+PAPER_PARTS = {"epyc": "paper-scale.new", "xeon": "paper-scale-xeon.new"}
+PAPER_RIVALS = ["pn-pcg", "pn-pcg-mf", "pn-mgpcg", "lbfgs-h", "lbfgs-ml"]
+
+
+def paper_part(tag):
+    """results/paper-scale*'s part of one machine, as scripts/paper_scale_table.py reads it."""
+    study = PAPER_PARTS[tag]
+    reads(study)
+    d = os.path.join(RESULTS, study)
+    if d not in _cache:
+        if not os.path.isfile(os.path.join(d, "cells.csv")):
+            raise Missing(f"results/{study}/cells.csv does not exist")
+        _cache[d] = paper_scale_table.Part(d)
+    return _cache[d]
+
+
+def paper_part_particles(tag):
+    p = paper_part(tag)
+    n = [num(c.row, "particles") for (sc, _), c in p.study[3].items() if sc in p.done]
+    if not n:
+        raise Missing(f"results/{PAPER_PARTS[tag]} has no finished scene")
+    return f"{grouped(min(n))} to {grouped(max(n))}"
+
+
+def paper_part_lead(tag, solver, what):
+    """HOT's total speedup over `solver` on the part's scenes (over the sampled frames, medians of the
+    runs): geometric mean, range, or the scenes it covers; pairs that met eps on a quiet machine only."""
+    p = paper_part(tag)
+    sp = {sc: s.total for sc, s in p.speed.get(solver, {}).items() if sc in p.done}
+    if not sp:
+        raise Missing(f"results/{PAPER_PARTS[tag]}: no scene times both hot and {solver}")
+    if what == "geomean":
+        return sig(matrix_report.geomean(list(sp.values())))
+    if what == "range":
+        return span(sp.values()) if len(sp) > 1 else sig(next(iter(sp.values())))
+    return str(len(sp))
+
+
+def paper_part_bounds(tag, solver):
+    """HOT's lead over `solver` where a part has only its bound (one run stopped by a time limit): at
+    least the bound's seconds over HOT's slowest run, per scene (scripts/paper_scale_table.py)."""
+    p = paper_part(tag)
+    out = [f"at least {sig(paper_scale_table.bound_speedups(b, p.study[3][(sc, 'hot')])[0])}x on {sc}"
+           for (sc, so), b in sorted(p.bounds.items()) if so == solver and sc in p.done and not b.busy]
+    return "; ".join(out) if out else "none"
+
+
 def smoother_ratio(solver, what="geo"):
     """smoother-precision: mean s/frame of the single runs over that of the
     double runs per scene (quiet machine), geometric mean or range."""
@@ -712,6 +763,18 @@ NUMBERS = {
     "bos.lead_2t_n": lambda: bos_lead(2, "n"),
     "bos.lead_1t": lambda: bos_lead(1),
     "bos.lead_1t_range": lambda: bos_lead(1, "range"),
+    **{f"paper.{tag}.n_scenes": (lambda tag=tag: str(len(paper_part(tag).done))) for tag in PAPER_PARTS},
+    **{f"paper.{tag}.scenes": (lambda tag=tag: ", ".join(paper_part(tag).done)) for tag in PAPER_PARTS},
+    **{f"paper.{tag}.particles": (lambda tag=tag: paper_part_particles(tag)) for tag in PAPER_PARTS},
+    **{f"paper.{tag}.hot_fastest": (lambda tag=tag: of(len(paper_scale_table.hot_rank(paper_part(tag)).alone),
+                                                       len(paper_scale_table.hot_rank(paper_part(tag)).ranked)))
+       for tag in PAPER_PARTS},
+    **{f"paper.{tag}.hot_tied": (lambda tag=tag: ", ".join(paper_scale_table.hot_rank(paper_part(tag)).tied) or "none")
+       for tag in PAPER_PARTS},
+    **{f"paper.{tag}.{so}_bounds": (lambda tag=tag, so=so: paper_part_bounds(tag, so))
+       for tag in PAPER_PARTS for so in PAPER_RIVALS},
+    **{f"paper.{tag}.{so}_{what}": (lambda tag=tag, so=so, what=what: paper_part_lead(tag, so, what))
+       for tag in PAPER_PARTS for so in PAPER_RIVALS for what in ("geomean", "range", "n")},
     "paper.cells": lambda: cells_ok("paper-scale"),
     "paper.date": lambda: run_date("paper-scale"),
     "paper.n_scenes": lambda: str(len(paper_scenes())),

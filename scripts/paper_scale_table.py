@@ -39,6 +39,7 @@ import os
 import statistics
 import subprocess
 import sys
+import types
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import matrix_report as mr  # noqa: E402
@@ -280,13 +281,21 @@ def check_parts(parts):
             seen[sc] = p.dir
 
 
-def summary(p, solvers):
-    """The bullets of one part: HOT's rank among the paper's solvers, and its speedup over each."""
-    _, _, _, timed, _ = p.study
+def hot_rank(p):
+    """HOT's place among the paper's solvers on the finished scenes of part p: the scenes ranked, and
+    those where HOT was the fastest alone, tied for the fastest, or slower than another."""
     ranked = [sc for sc in p.done if p.wins.get(sc)]
     alone = [sc for sc in ranked if p.wins[sc] == [HOT]]
     tied = [sc for sc in ranked if HOT in p.wins[sc] and len(p.wins[sc]) > 1]
     lost = [sc for sc in ranked if HOT not in p.wins[sc]]
+    return types.SimpleNamespace(ranked=ranked, alone=alone, tied=tied, lost=lost)
+
+
+def summary(p, solvers):
+    """The bullets of one part: HOT's rank among the paper's solvers, and its speedup over each."""
+    _, _, _, timed, _ = p.study
+    rank = hot_rank(p)
+    ranked, alone, tied, lost = rank.ranked, rank.alone, rank.tied, rank.lost
     print(f"- Among the paper's solvers ({', '.join(p.paper_set)}) HOT was the fastest on {len(alone)} of "
           f"{len(ranked)} scenes "
           f"by more than the spread of the runs, tied for the fastest on {len(tied)}"

@@ -9,7 +9,8 @@
 # HOT's speedups from the sampled frames, and a lower bound on them from a
 # run the matrix excludes, stopped by its time limit (DIR/bounds/NAME/),
 # refusing one that timed other states or was not stopped, and a study whose runs
-# come from two machines, joining parts from two machines a scene each;
+# come from two machines, joining parts from two machines a scene each (and
+# scripts/fill_numbers.py quoting each part's numbers apart);
 # scripts/reproduce.sh remakes a study made in parts whole; other scenes run as before; a second
 # `matrix run` has nothing to do; the sampled frames are part of the ids;
 # a bad list, or first_timed_frame beside sample_frames, is a one-line
@@ -200,6 +201,38 @@ python3 "$src/scripts/paper_scale_table.py" "$tmp/pa" "$tmp/r" >/dev/null 2>"$tm
 rc=$?
 check "a scene in two parts: exit 2 ($(head -c 200 "$tmp/parts2.err"))" \
   bash -c "test $rc -eq 2 && grep -q \"$tmp/r: scene 'sauce' is also in $tmp/pa: a scene's runs come from one machine\" '$tmp/parts2.err'"
+
+# the numbers the pages quote from such a table (scripts/fill_numbers.py's paper.<part>.* keys) are
+# each part's own: its scenes, and HOT's lead over pn-pcg as that part's summary line gives it (the
+# parts' cells marked quiet here, so that a lead is claimed whatever the load of the machine testing)
+python3 - "$tmp/pa" "$tmp/pb" <<'PY'
+import csv, sys
+for d in sys.argv[1:]:
+    rows = list(csv.DictReader(open(f"{d}/cells.csv")))
+    with open(f"{d}/cells.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(dict(r, machine_busy="0") for r in rows)
+PY
+python3 "$src/scripts/paper_scale_table.py" "$tmp/pa" "$tmp/pb" >"$tmp/quiet.md" 2>&1
+python3 - "$tmp" "$src/scripts" "$tmp/quiet.md" >"$tmp/keys.txt" 2>&1 <<'PY'
+import re, sys
+tmp, scripts, table = sys.argv[1:]
+sys.path.insert(0, scripts)
+import fill_numbers as f
+f.RESULTS, f.PAPER_PARTS = tmp, {"epyc": "pa", "xeon": "pb"}
+text = open(table).read()
+for tag, part, scene in (("epyc", "pa", "sauce"), ("xeon", "pb", "bar3")):
+    assert f.value(f"paper.{tag}.scenes")[0] == scene, (tag, f.value(f"paper.{tag}.scenes"))
+    section = text.split(f"({tmp}/{part}):")[1].split("\nOn ")[0]
+    printed = float(re.search(r"HOT against pn-pcg: ([0-9.]+)x", section).group(1))
+    quoted = float(f.value(f"paper.{tag}.pn-pcg_geomean")[0])
+    assert abs(quoted - printed) <= 0.01 * printed, (tag, quoted, printed)
+    assert f.value(f"paper.{tag}.pn-pcg_n")[0] == "1", f.value(f"paper.{tag}.pn-pcg_n")
+print("ok")
+PY
+check "per-part keys: each part's scenes and its own lead over pn-pcg ($(tail -1 "$tmp/keys.txt"))" \
+  grep -qx ok "$tmp/keys.txt"
 
 # scripts/reproduce.sh remakes a study made part by part (every invocation with --only) whole: the
 # committed cells' scenes and solvers, a scene with every solver as scene/*, the globs reaching
