@@ -94,6 +94,11 @@ const Option run_settings[] = {
      run_check_frame_list, 0,
      "write the whole simulation state at the start of these frames (0 = the initial state) into "
      "OUT/checkpoints/frame_NNNN.ckpt"},
+    {"--checkpoint-every-s", NULL, "S", OPT_REAL, 0, 1e9, "seconds", NULL, F(checkpoint_every_s), 0, NULL,
+     OPT_MIN_OPEN,
+     "also write OUT/checkpoints/resume.ckpt at the start of a frame once S seconds have passed since the run began "
+     "or since the last one (each replaces the one before), so that a long run stopped midway goes on with --from "
+     "(a matrix's checkpoint reference run does so by itself)"},
     {"--from", NULL, "FILE", OPT_TEXT, 0, 0, "a checkpoint file", NULL, F(from), 0, NULL, 0,
      "continue from a checkpoint (--checkpoint-at) of the same scene, scale and --set: the steps from its frame on "
      "are those of the run that wrote it, bit for bit; --frames is still the last frame"},

@@ -36,7 +36,13 @@ static void put(Writer *w, const void *p, size_t n)
 
 int checkpoint_write(const char *path, const Simulation *sim, uint64_t scene_fingerprint)
 {
-    Writer w = {fopen(path, "wb"), CHECKPOINT_FNV_BASIS, 0};
+    /* written beside its name and renamed into place, so a run stopped while
+     * it writes leaves the previous file or none, never a partial one (a
+     * resumed matrix reference continues from the newest it finds) */
+    char part[1200];
+    int len = snprintf(part, sizeof part, "%s.part", path);
+    if (len < 0 || (size_t)len >= sizeof part) return mpm_error(MPM_EINPUT, "%s: path too long for a checkpoint", path);
+    Writer w = {fopen(part, "wb"), CHECKPOINT_FNV_BASIS, 0};
     if (!w.f) return mpm_error(MPM_EINPUT, "%s: cannot write the checkpoint", path);
     const Particles *p = &sim->p;
     uint32_t version = FORMAT_VERSION, order = BYTE_ORDER_MARK, has_jp = p->Jp != NULL, pad = 0;
@@ -65,7 +71,11 @@ int checkpoint_write(const char *path, const Simulation *sim, uint64_t scene_fin
     uint64_t hash = w.hash;
     if (!w.failed && fwrite(&hash, sizeof hash, 1, w.f) != 1) w.failed = 1;
     if (fclose(w.f) != 0) w.failed = 1;
-    if (w.failed) return mpm_error(MPM_EINPUT, "%s: cannot write the checkpoint (disk full?)", path);
+    if (!w.failed && rename(part, path) != 0) w.failed = 1;
+    if (w.failed) {
+        remove(part);
+        return mpm_error(MPM_EINPUT, "%s: cannot write the checkpoint (disk full?)", path);
+    }
     return MPM_OK;
 }
 

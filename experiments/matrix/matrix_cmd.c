@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "core/scene/data_dir.h"
 #include "core/threads.h"
+#include "experiments/matrix/matrix_resume.h"
 #include "experiments/matrix/matrix_run.h"
 #include "experiments/matrix/matrix_schema.h"
 
@@ -33,6 +34,10 @@ static const Option matrix_run_options[] = {
      "threads of every cell, replacing defaults.threads (refused when the matrix has a threads axis)"},
     {"--asset-dir", NULL, "DIR", OPT_TEXT, 0, 0, "a directory name", NULL, O(asset_dir), 0, NULL, 0,
      "where the scenes' mesh files are, relative to the working directory (replaces defaults.asset_dir)"},
+    {"--checkpoint-every-s", NULL, "S", OPT_REAL, 0, 1e9, "seconds", NULL, O(checkpoint_every_s), 0, NULL,
+     OPT_MIN_OPEN,
+     "seconds between the resume checkpoints of a reference run that writes checkpoints (sample_frames; default "
+     OPT_SPELLED(MATRIX_RESUME_EVERY_S) "): stopped midway, it goes on from the newest at the next matrix run"},
     {"--check", NULL, NULL, OPT_SWITCH, 0, 0, NULL, NULL, O(check), 0, NULL, 0,
      "afterwards judge every cell (stable, converged, no energy rise): DIR/check.csv; exit 3 when one failed"},
     {NULL}};

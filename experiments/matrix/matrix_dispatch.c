@@ -9,7 +9,9 @@
 
 #include "core/error.h"
 #include "experiments/io/machine_load.h"
+#include "core/event_log.h"
 #include "experiments/matrix/matrix_child.h"
+#include "experiments/matrix/matrix_resume.h"
 #include "experiments/matrix/matrix_results.h"
 #include "experiments/io/paths.h"
 
@@ -33,10 +35,12 @@ typedef struct {
     MatrixTask task;
     CellChild child;
     int busy;
+    int attempts;       /* a resumed cell's earlier attempts (matrix_resume.h) */
+    double recorded;    /* event_clock() of its last progress record */
 } Slot;
 
 /* DIR/cmd.txt: the command line, shell-quoted, to rerun the cell by hand. */
-static void write_command(const MatrixTask *t, char *const *args)
+static void write_command(const MatrixTask *t, char *const *args, int argc)
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/cmd.txt", t->dir);
@@ -44,7 +48,7 @@ static void write_command(const MatrixTask *t, char *const *args)
     if (!f) return;
     if (t->ranks > 1) fprintf(f, "mpirun -np %d ", t->ranks);
     fputs("mpmbench", f);
-    for (int i = 0; i < t->argc; ++i) {
+    for (int i = 0; i < argc; ++i) {
         int plain = args[i][0] != '\0';
         for (const char *c = args[i]; *c && plain; ++c) plain = strchr("/._-=:+,", *c) || (*c >= '0' && *c <= '9') ||
                                                               (*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z');
@@ -66,31 +70,54 @@ static void write_command(const MatrixTask *t, char *const *args)
 static int slot_start(Slot *s, const MatrixTask *t)
 {
     memcpy(&s->task, t, offsetof(MatrixTask, args) + (size_t)t->args_len);
-    char *args[MAX_ARGS];
+    char *args[MAX_ARGS + 2], from[1200];
     if (t->argc > MAX_ARGS) return mpm_error(MPM_EINTERNAL, "cell %s: too many arguments", t->dir);
     size_t off = 0;
-    for (int i = 0; i < t->argc; ++i) {
+    int argc = t->argc;
+    for (int i = 0; i < argc; ++i) {
         args[i] = s->task.args + off;
         off += strlen(args[i]) + 1;
     }
-    /* whatever is there is a cell that did not finish: redo it from scratch */
-    int st = matrix_remove_tree(t->dir);
-    if (!st) st = paths_mkdir_p(t->dir);
+    /* whatever is there is a cell that did not finish: redo it from scratch,
+     * unless it is a checkpoint reference that can go on from a checkpoint */
+    s->attempts = 0;
+    int st = t->resumable ? matrix_resume_prepare(t->dir, from, sizeof from, &s->attempts) : MPM_OK;
+    if (!st && !s->attempts) {
+        st = matrix_remove_tree(t->dir);
+        if (!st) st = paths_mkdir_p(t->dir);
+    }
     if (st) return st;
-    write_command(&s->task, args);
-    if ((st = cell_child_start(args, t->argc, t->dir, t->timeout_s, t->ranks, &s->child))) return st;
+    if (s->attempts) {
+        args[argc++] = "--from";
+        args[argc++] = from;
+        printf("[resuming] %s from %s (attempt %d)\n", t->dir, from, s->attempts + 1);
+        fflush(stdout);
+    }
+    write_command(&s->task, args, argc);
+    if ((st = cell_child_start(args, argc, t->dir, t->timeout_s, t->ranks, &s->child))) return st;
     s->busy = 1;
+    s->recorded = -1e30;
     return MPM_OK;
 }
 
 static int slot_poll(Slot *s, int rank, MatrixResult *r)
 {
     CellOutcome o;
-    if (!s->busy || !cell_child_poll(&s->child, &o)) return 0;
+    if (!s->busy) return 0;
+    if (s->task.resumable && event_clock() - s->recorded >= MATRIX_PROGRESS_EVERY_S) {
+        matrix_resume_record(s->task.dir, &s->child); /* what a stop would otherwise lose of its cost */
+        s->recorded = event_clock();
+    }
+    if (!cell_child_poll(&s->child, &o)) return 0;
     memset(r, 0, sizeof *r);
     r->index = s->task.index;
     r->rank = rank;
     r->outcome = o;
+    /* a resumed cell: its rows and its cost from every attempt */
+    if (s->task.resumable && matrix_resume_finish(s->task.dir, s->attempts, &r->outcome)) {
+        fprintf(stderr, "mpmbench: %s\n", mpm_last_error());
+        r->outcome.status = CELL_FAILED;
+    }
     cell_measure(s->task.dir, s->task.first_timed_frame, &r->measure);
     if (r->outcome.status == CELL_OK && r->measure.cut_short) r->outcome.status = CELL_TIME_LIMIT;
     long cores = sysconf(_SC_NPROCESSORS_ONLN);

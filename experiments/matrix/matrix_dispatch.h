@@ -28,6 +28,7 @@ typedef struct {
     int ranks;                 /* > 1: the cell runs under mpirun -np ranks */
     double timeout_s;          /* 0: none */
     int after;                 /* position in the task list of the task this one waits for; -1: none */
+    int resumable;             /* a checkpoint reference: a stopped attempt goes on (matrix_resume.h) */
     char dir[1024];            /* the cell directory (wiped and recreated) */
     int argc;
     int args_len;

@@ -18,6 +18,7 @@
 #include "experiments/matrix/matrix_results.h"
 #include "experiments/io/mpi_launcher.h"
 #include "experiments/io/paths.h"
+#include "experiments/matrix/matrix_resume.h"
 #include "experiments/matrix/matrix_validate.h"
 #include "experiments/run/provenance.h"
 
@@ -31,6 +32,7 @@ typedef struct {
     int n_status[CELL_N_STATUS];
     double t_start, last_tick;
     int terminal, tick_shown;
+    double checkpoint_every_s; /* a checkpoint reference's resume checkpoints (matrix_resume.h) */
 } Run;
 
 static int matches_only(const MatrixCell *c, const MatrixRunOptions *o)
@@ -268,9 +270,14 @@ static int build_tasks(Run *r, MatrixTask **out)
         t[n].first_timed_frame = c->first_timed_frame;
         t[n].ranks = c->run.ranks;
         t[n].timeout_s = c->timeout_s;
+        /* a reference that simulates a whole animation for its checkpoints can outlast the session:
+         * it leaves resume checkpoints, and a later matrix run goes on from them (matrix_resume.h) */
+        MatrixCell cell = *c;
+        t[n].resumable = c->is_reference && c->sample_frames;
+        if (t[n].resumable) cell.run.checkpoint_every_s = r->checkpoint_every_s;
         int w = snprintf(t[n].dir, sizeof t[n].dir, "%s/cells/%s", r->dir, c->id);
         int st = w < 0 || (size_t)w >= sizeof t[k].dir ? mpm_error(MPM_EINPUT, "%s: output path too long", r->dir) : MPM_OK;
-        if (!st) st = matrix_cell_argv(&r->m, c, t[n].dir, t[n].args, sizeof t[n].args, &t[n].argc);
+        if (!st) st = matrix_cell_argv(&r->m, &cell, t[n].dir, t[n].args, sizeof t[n].args, &t[n].argc);
         if (st) {
             free(t);
             free(pos);
@@ -414,6 +421,7 @@ int matrix_run(const char *file, const MatrixRunOptions *o, int *failed)
     if (rank == 0) st = prepare(&r, file, o, use_mpi, ranks, &go);
     if (go && rank == 0) {
         /* before the other ranks hear go: an error here must stop them too */
+        r.checkpoint_every_s = o->checkpoint_every_s > 0 ? o->checkpoint_every_s : MATRIX_RESUME_EVERY_S;
         if ((st = build_tasks(&r, &tasks))) go = 0;
         const char *ci = getenv("CI");
         r.terminal = isatty(STDERR_FILENO) && !(ci && *ci);

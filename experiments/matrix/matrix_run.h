@@ -31,6 +31,7 @@ typedef struct {
     const char *asset_dir;            /* NULL: the matrix's */
     int threads;                      /* > 0: replaces defaults.threads (refused with a threads axis) */
     int check;                        /* --check: the stability verdict of every cell (matrix_check.h) */
+    double checkpoint_every_s;        /* > 0: a checkpoint reference's resume checkpoints (matrix_resume.h) */
 } MatrixRunOptions;
 
 int matrix_run(const char *file, const MatrixRunOptions *o, int *failed);

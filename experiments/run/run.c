@@ -246,6 +246,7 @@ int run_config_check(const RunConfig *cfg)
         /* each sampled frame runs alone: nothing that follows one trajectory */
         const char *other = cfg->from             ? "--from"
                             : cfg->checkpoint_at  ? "--checkpoint-at"
+                            : cfg->checkpoint_every_s > 0 ? "--checkpoint-every-s"
                             : cfg->dt_from        ? "--dt-from"
                             : cfg->trajectory_ref ? "--trajectory-ref"
                             : cfg->trajectory     ? "--trajectory"
@@ -297,6 +298,8 @@ typedef struct {
     const char *out_dir;
     uint64_t fingerprint;      /* the scene's, for checkpoints */
     const CommOps *comm;       /* a distributed run's ranks, else NULL */
+    int first_frame;           /* the frame the run starts at (0, or --from's) */
+    double resume_clock;       /* event_clock() of the run's start or its last resume checkpoint */
 } RunOutput;
 
 /* --sample-frames: the state at the start of a sampled frame, from its checkpoint */
@@ -325,6 +328,16 @@ static int before_step(void *ctx, Simulation *sim, int frame, int step, StepWork
         int st = paths_mkdir_p(path);
         snprintf(path, sizeof path, "%s/checkpoints/frame_%04d.ckpt", o->out_dir, frame);
         if (st || (st = checkpoint_write(path, sim, o->fingerprint))) return st;
+    }
+    /* --checkpoint-every-s: where a stopped run goes on from (each replaces the last) */
+    if (step == 0 && o->cfg->checkpoint_every_s > 0 && frame > o->first_frame &&
+        event_clock() - o->resume_clock >= o->cfg->checkpoint_every_s) {
+        char path[1200];
+        snprintf(path, sizeof path, "%s/checkpoints", o->out_dir);
+        int st = paths_mkdir_p(path);
+        snprintf(path, sizeof path, "%s/checkpoints/resume.ckpt", o->out_dir);
+        if (st || (st = checkpoint_write(path, sim, o->fingerprint))) return st;
+        o->resume_clock = event_clock();
     }
     return run_accuracy_before_step(o->acc, sim, step, w);
 }
@@ -451,9 +464,11 @@ static void write_run_json(const char *dir, const RunConfig *cfg, const Scene *s
     if (root) json_object_set_new(root, "accuracy", (json_t *)run_accuracy_json(&ac, acc));
     if (root) /* where the run started and where it leaves checkpoints */
         json_object_set_new(root, "checkpoints",
-                            json_pack("{s:o, s:i, s:o, s:o, s:o}", "from", cfg->from ? json_string(cfg->from) : json_null(),
-                                      "first_frame", first_frame, "at",
-                                      cfg->checkpoint_at ? json_string(cfg->checkpoint_at) : json_null(),
+                            json_pack("{s:o, s:i, s:o, s:o, s:o, s:o}", "from",
+                                      cfg->from ? json_string(cfg->from) : json_null(), "first_frame", first_frame,
+                                      "at", cfg->checkpoint_at ? json_string(cfg->checkpoint_at) : json_null(),
+                                      "every_s",
+                                      cfg->checkpoint_every_s > 0 ? json_real(cfg->checkpoint_every_s) : json_null(),
                                       "sample_from", cfg->sample_from ? json_string(cfg->sample_from) : json_null(),
                                       "sample_frames",
                                       cfg->sample_frames ? json_string(cfg->sample_frames) : json_null()));
@@ -556,6 +571,7 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
                             : cfg->dt_from        ? "--dt-from"
                             : cfg->error_ref      ? "--error-ref"
                             : cfg->checkpoint_at  ? "--checkpoint-at"
+                            : cfg->checkpoint_every_s > 0 ? "--checkpoint-every-s"
                             : cfg->from           ? "--from"
                             : cfg->sample_frames  ? "--sample-frames"
                                                   : NULL;
@@ -594,7 +610,8 @@ int run_simulation(const RunConfig *cfg, RunSummary *sum)
     int largest = -1;
     if (cfg->checkpoint_at) frame_listed(cfg->checkpoint_at, -1, &largest);
     if ((status = run_accuracy_bind(&acfg, scene, frames, &acc)) ||
-        ((cfg->from || cfg->checkpoint_at || n_samples) && (status = run_scene_fingerprint(cfg, scene, &fingerprint))) ||
+        ((cfg->from || cfg->checkpoint_at || cfg->checkpoint_every_s > 0 || n_samples) &&
+         (status = run_scene_fingerprint(cfg, scene, &fingerprint))) ||
         (cfg->from && (status = checkpoint_read(cfg->from, sim, fingerprint)))) {
         run_accuracy_free(&acc);
         session_close(&ses);
@@ -676,7 +693,8 @@ setup_end:
                "max_resid", "status");
     }
     RunOutput out = {cfg,     scene,   solver,      &acc, steps_csv, frames_csv, iters_csv, threads,
-                     cfg->vtk_dir ? &vtk : NULL, out_dir, fingerprint, ses.has_comm ? &ses.comm : NULL};
+                     cfg->vtk_dir ? &vtk : NULL, out_dir, fingerprint, ses.has_comm ? &ses.comm : NULL,
+                     sim->frame, event_clock()};
     FrameDriver driver = {.frames = frames,
                           .sample_frames = samples,
                           .n_samples = n_samples,

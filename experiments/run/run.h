@@ -56,6 +56,8 @@ typedef struct {
     size_t max_particles;       /* particle budget (--max-particles); 0: scene_default_max_particles() */
     /* checkpoints (experiments/io/checkpoint.h; NULL = none) */
     const char *checkpoint_at;  /* --checkpoint-at F,F,...: OUT/checkpoints/frame_NNNN.ckpt at those frames' starts */
+    double checkpoint_every_s;  /* --checkpoint-every-s S: OUT/checkpoints/resume.ckpt at a frame's start once S
+                                 * seconds passed since the run began or the last one (0 = none) */
     const char *from;           /* --from FILE: continue from a checkpoint, bit for bit */
     const char *sample_from;    /* --sample-from DIR: a run's checkpoints folder */
     const char *sample_frames;  /* --sample-frames F,F,...: time each frame alone from its checkpoint in sample_from */

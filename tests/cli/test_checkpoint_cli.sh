@@ -4,7 +4,10 @@
 # frames 0..8 writing checkpoints at frames 0 and 5 and a run continued from
 # frame 5 give identical steps.csv and frames.csv rows from frame 5 on (every
 # column but the times), at 1 and 2 threads; from frame 0 the whole run is
-# reproduced. A corrupt, truncated or mismatched checkpoint (another scale,
+# reproduced. --checkpoint-every-s leaves one resume checkpoint (at the last
+# frame's start when every frame passes the interval) from which the run
+# goes on bit for bit, and no partial file. A corrupt, truncated or
+# mismatched checkpoint (another scale,
 # another --set), a list frame past the end and --from with nothing left to
 # run are one-line errors with exit 2, before any output.
 . "$(dirname "$0")/../common/shell_harness.sh"
@@ -41,6 +44,20 @@ check "from frame 0: the whole run ($out)" test "$out" = ok
 check "run.json records where it started" python3 -c "
 import json, sys; c = json.load(open('$tmp/from5-1/run.json'))['checkpoints']
 sys.exit(not (c['first_frame'] == 5 and c['from'].endswith('frame_0005.ckpt') and c['at'] is None))"
+
+run --frames 9 --threads 2 --checkpoint-every-s 1e-9 --out "$tmp/every"
+check "--checkpoint-every-s: exit 0" test $? -eq 0
+check "--checkpoint-every-s: one resume checkpoint, no partial file" \
+  test "$(ls "$tmp/every/checkpoints")" = resume.ckpt
+run --frames 9 --threads 2 --from "$tmp/every/checkpoints/resume.ckpt" --out "$tmp/from-resume"
+check "from the resume checkpoint: exit 0" test $? -eq 0
+out=$(same_rows "$tmp/full" "$tmp/from-resume" 8 steps.csv 2>&1 | tail -1)
+check "from the resume checkpoint: the last frame's rows, as the full run's ($out)" test "$out" = ok
+check "run.json records the interval" python3 -c "
+import json, sys; sys.exit(json.load(open('$tmp/every/run.json'))['checkpoints']['every_s'] != 1e-9)"
+expect_input_error "--checkpoint-every-s '0': expected seconds in \\(0, 1e9\\]" "${S[@]}" --checkpoint-every-s 0 --out "$tmp/x10"
+expect_input_error "--sample-frames: not with --checkpoint-every-s" "${S[@]}" --checkpoint-every-s 5 \
+  --sample-from "$tmp/full/checkpoints" --sample-frames 5 --out "$tmp/x11"
 
 ck="$tmp/full/checkpoints/frame_0005.ckpt"
 head -c 200 "$ck" >"$tmp/short.ckpt"
