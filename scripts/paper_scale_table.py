@@ -28,7 +28,12 @@ slowest run, and the table prints it as such. --rerun-bounds runs the
 bounds of a study again into a rerun of it (scripts/reproduce.sh does).
 
 Timings from two machines are never one study: every run of a folder must
-name one CPU model (and one build), or the script stops. A matrix run in
+name one CPU model, and every timed run one build, or the script stops. A
+reference run gives the cells their states and the whole-animation column
+only; it may come from another build (a build that can resume it, for a
+reference longer than a session), which the table names, and then its
+scene's "sampled / whole" ratio, which would compare two builds, is left
+out. A matrix run in
 parts on different machines, each scene wholly on one, is given as several
 folders: one table, each scene's row naming its machine, and the summary
 (geometric means, ranks) once per machine, never pooled.
@@ -243,7 +248,10 @@ class Part:
         self.study = load(d)
         meta, scenes, solvers, timed, refs = self.study
         ran = list(timed.values()) + list(refs.values())
-        self.machine, self.commit = study_machine(ran), study_commit(ran)
+        # one machine for every run; one build for the timed runs (a reference only gives them their states)
+        self.machine, self.commit = study_machine(ran), study_commit(list(timed.values()))
+        self.ref_builds = {sc: {run_commit(r.run) for r in c.runs} - {None} for sc, c in refs.items()}
+        self.other_build = {sc: sorted(b)[0] for sc, b in self.ref_builds.items() if b and b != {self.commit}}
         self.present = {c.row["scene"] for c in ran}
         self.speed = hot_speedups(self.study)
         self.paper_set = [so for so in solvers if so == HOT or so in PAPER_TOTAL]
@@ -421,10 +429,18 @@ def main(dirs):
         slowest = max(ref.frame_time.values()) if ref.frame_time else float("nan")
         whole = ref.s_per_frame
         busy = " busy" if ref.busy else ""
+        other = p.other_build.get(sc)
+        ratio = (f"- (reference: build {other[:7]})" if other
+                 else mr.fmt(same.s_per_frame / whole if whole else float('nan')))
         print(f"| {sc} |{where(p)} {ref.solver} | {len(ref.frame_time)} | {ref.row.get('steps', '-')} | "
-              f"{mr.fmt(whole)}{busy} | {mr.fmt(slowest)} | {mr.fmt(same.s_per_frame)} | "
-              f"{mr.fmt(same.s_per_frame / whole if whole else float('nan'))} | "
+              f"{mr.fmt(whole)}{busy} | {mr.fmt(slowest)} | {mr.fmt(same.s_per_frame)} | {ratio} | "
               f"{mr.number(ref.row.get('peak_rss_mb'), 0.0):.0f} |")
+    others = [(sc, p) for sc, p in rows if p.other_build.get(sc)]
+    if others:
+        print("\n" + "; ".join(f"{sc}'s reference ran on build {p.other_build[sc][:7]}, its cells on "
+                               f"{(p.commit or '?')[:7]}" for sc, p in others)
+              + ": its states are those the cells' build would reach (the page says how that was checked), "
+              "and its times are not compared with the cells'.")
     bounded = [(sc, so, b, p) for p in parts for (sc, so), b in sorted(p.bounds.items())]
     if bounded:
         print("\nBounds: solvers a scene could not time three times, each run once from the same checkpoints "

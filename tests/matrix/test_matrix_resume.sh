@@ -118,6 +118,7 @@ check "run b resumed: the rows equal the uninterrupted run's ($out)" test "$out"
 # an attempt without its progress record (stopped before the first, or run by an
 # older runner) is not one to go on from: the reference starts over
 state=$(interrupt "$tmp/c")
+check "run c: the runner was killed while the reference ran ($state)" test "$state" = stopped
 rm -f "$tmp/c/cells/$ref/progress.txt"
 "$bin" "${M[@]}" --out "$tmp/c" >"$tmp/c2.txt" 2>&1
 rc=$?

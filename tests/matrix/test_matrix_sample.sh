@@ -9,7 +9,8 @@
 # HOT's speedups from the sampled frames, and a lower bound on them from a
 # run the matrix excludes, stopped by its time limit (DIR/bounds/NAME/),
 # refusing one that timed other states or was not stopped, and a study whose runs
-# come from two machines, joining parts from two machines a scene each (and
+# come from two machines (or whose timed runs come from two builds; a
+# reference from another build is named, its ratio left out), joining parts from two machines a scene each (and
 # scripts/fill_numbers.py quoting each part's numbers apart);
 # scripts/reproduce.sh remakes a study made in parts whole; other scenes run as before; a second
 # `matrix run` has nothing to do; the sampled frames are part of the ids;
@@ -147,12 +148,28 @@ rm -r "$bound"
 pn=$(python3 -c 'import csv, sys; print(next(r["id"] for r in csv.DictReader(open(sys.argv[1]))
   if (r["scene"], r["solver"], r["role"]) == ("sauce", "pn-pcg", "cell")))' "$tmp/r/cells.csv")
 cp "$tmp/r/cells/$pn/run.json" "$tmp/pn-run.json"
-sed -i 's/"cpu_model": *"[^"]*"/"cpu_model": "Other CPU"/' "$tmp/r/cells/$pn/run.json"
-python3 "$src/scripts/paper_scale_table.py" "$tmp/r" >/dev/null 2>"$tmp/merr"
+other_cell() { # FIELD VALUE PATTERN: a timed cell whose run.json names another FIELD is refused
+  sed -i "s/\"$1\": *\"[^\"]*\"/\"$1\": \"$2\"/" "$tmp/r/cells/$pn/run.json"
+  python3 "$src/scripts/paper_scale_table.py" "$tmp/r" >/dev/null 2>"$tmp/merr"
+  local rc=$?
+  check "a cell with another $1: exit 2, one line ($(head -c 200 "$tmp/merr"))" \
+    bash -c "test $rc -eq 2 && test \$(wc -l <'$tmp/merr') -eq 1 && grep -q '$3' '$tmp/merr'"
+  cp "$tmp/pn-run.json" "$tmp/r/cells/$pn/run.json"
+}
+other_cell cpu_model "Other CPU" 'the cells ran on 2 machines (.*Other CPU.*): not one study'
+other_cell git_commit 0000000000000000000000000000000000000001 'the cells ran on 2 builds (.*0000000001.*): not one study'
+# the reference (its states and the whole-animation column only) may come from another build: the
+# table names it and leaves out its sampled/whole ratio
+cp "$tmp/r/cells/$ref/run.json" "$tmp/ref-run.json"
+cp -r "$tmp/bound.ok" "$bound" # with its bound sauce is complete and in the table
+sed -i 's/"git_commit": *"[^"]*"/"git_commit": "0000000000000000000000000000000000000001"/' "$tmp/r/cells/$ref/run.json"
+python3 "$src/scripts/paper_scale_table.py" "$tmp/r" >"$tmp/refbuild.md" 2>&1
 rc=$?
-check "a cell from another machine: exit 2, one line ($(head -c 200 "$tmp/merr"))" \
-  bash -c "test $rc -eq 2 && test \$(wc -l <'$tmp/merr') -eq 1 && grep -q 'the cells ran on 2 machines (.*Other CPU.*): not one study' '$tmp/merr'"
-cp "$tmp/pn-run.json" "$tmp/r/cells/$pn/run.json"
+check "a reference from another build: exit $rc, named, its ratio left out ($(grep -m1 '^| sauce | pn-pcg | 7' "$tmp/refbuild.md"))" \
+  bash -c "test $rc -eq 0 && grep -q '^| sauce | pn-pcg | 7 | .* | - (reference: build 0000000) |' '$tmp/refbuild.md' &&
+    grep -q \"^sauce's reference ran on build 0000000, its cells on \" '$tmp/refbuild.md'"
+cp "$tmp/ref-run.json" "$tmp/r/cells/$ref/run.json"
+rm -r "$bound"
 "$bin" run --scene sauce --solver lbfgs-h --scale 5 --threads 2 --sample-from "$tmp/r/cells/$ref/checkpoints" \
   --sample-frames 1,4,6 --quiet --out "$bound" >"$tmp/whole.txt" 2>&1
 python3 "$src/scripts/paper_scale_table.py" "$tmp/r" >/dev/null 2>"$tmp/berr2"
