@@ -69,17 +69,22 @@ print("ok")
 PY
 }
 
+resumed() { # OUT NAME FROM: the next matrix run goes on from FROM (attempt 2) and ends as the uninterrupted run
+  "$bin" "${M[@]}" --out "$1" >"$1.resumed" 2>&1
+  check "run $2 resumed: exit 0" test $? -eq 0
+  check "run $2 resumed: it says it goes on from $3" \
+    grep -q "^\[resuming\] .*/cells/$ref from .*$3 (attempt 2)" "$1.resumed"
+  local out
+  out=$(same "$1" 2>&1 | tail -1)
+  check "run $2 resumed: the reference's rows and cells.csv equal the uninterrupted run's ($out)" test "$out" = ok
+}
+
 state=$(interrupt "$tmp/a")
 check "run a: the runner was killed while the reference ran ($state)" test "$state" = stopped
 check "run a: no cell process outlives the runner" bash -c "! pgrep -f '^mpmbench run .*$tmp/a/cells' >/dev/null"
 check "run a: a resume checkpoint and a progress record" \
   test -f "$tmp/a/cells/$ref/checkpoints/resume.ckpt" -a -f "$tmp/a/cells/$ref/progress.txt"
-"$bin" "${M[@]}" --out "$tmp/a" >"$tmp/a2.txt" 2>&1
-check "run a resumed: exit 0" test $? -eq 0
-check "run a resumed: it says it goes on from the resume checkpoint" \
-  grep -q "^\[resuming\] .*/cells/$ref from .*/cells/$ref/attempts/1/resume.ckpt (attempt 2)" "$tmp/a2.txt"
-out=$(same "$tmp/a" 2>&1 | tail -1)
-check "run a resumed: the reference's rows and cells.csv equal the uninterrupted run's ($out)" test "$out" = ok
+resumed "$tmp/a" a "/cells/$ref/attempts/1/resume.ckpt"
 check "run a resumed: the sampled checkpoints stay, the resume ones and the record go" bash -c "
   cd '$tmp/a/cells/$ref' && test -f checkpoints/frame_0003.ckpt -a -f checkpoints/frame_0040.ckpt \
     -a -f checkpoints/frame_0080.ckpt -a ! -e checkpoints/resume.ckpt -a ! -e attempts/1/resume.ckpt \
@@ -108,12 +113,7 @@ check "run b: the runner was killed while the reference ran ($state)" test "$sta
 python3 -c "
 b = bytearray(open('$tmp/b/cells/$ref/checkpoints/resume.ckpt', 'rb').read()); b[len(b) // 2] ^= 1
 open('$tmp/b/cells/$ref/checkpoints/resume.ckpt', 'wb').write(b)"
-"$bin" "${M[@]}" --out "$tmp/b" >"$tmp/b2.txt" 2>&1
-check "run b resumed: exit 0" test $? -eq 0
-check "run b resumed: from the sampled checkpoint before the damaged one" \
-  grep -q "^\[resuming\] .*/cells/$ref/checkpoints/frame_00[48]0.ckpt (attempt 2)" "$tmp/b2.txt"
-out=$(same "$tmp/b" 2>&1 | tail -1)
-check "run b resumed: the rows equal the uninterrupted run's ($out)" test "$out" = ok
+resumed "$tmp/b" b "/cells/$ref/checkpoints/frame_00[48]0.ckpt" # the sampled one before it
 
 # an attempt without its progress record (stopped before the first, or run by an
 # older runner) is not one to go on from: the reference starts over
