@@ -364,6 +364,9 @@ static int write_step(void *ctx, const Simulation *sim, int frame, int step, con
     run_accuracy_step_fields(f, o->acc);
     csv_write_text(f, ss->reason); /* the reason stays the last field */
     fputc('\n', f);
+    /* each step's row is on disk when the step ends: a frame of a large scene
+     * takes minutes, and a run stopped inside it keeps its finished steps */
+    fflush(f);
     return MPM_OK;
 }
 
@@ -409,7 +412,6 @@ static int write_frame_files(RunOutput *o, const Simulation *sim, const FrameSum
     csv_write_text(f, fs->reason);
     fputc('\n', f);
     if (status) return status;
-    fflush(o->steps_csv);
     fflush(f);
     if (!o->cfg->quiet)
         printf("%6d %6d %8ld %9ld %9ld %10.3f %12.3e  %s\n", fs->frame, fs->steps, fs->outer_iters, fs->linear_iters,
