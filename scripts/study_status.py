@@ -9,7 +9,8 @@ cells' run.json files and cells.csv:
 
 - build: the git commits its cells were built from (and whether the tree was
   modified), date range, machine (CPU model, cores);
-- repeats: the most runs any one cell setting has (cells.csv "repeat");
+- repeats: the most runs any one cell setting has (cells.csv "repeat"; a
+  reference run and a timed cell of the same solver are two settings);
 - busy: cells that ran while other work used the machine (machine_busy = 1);
 - stale solvers: a solver is stale when the definition its cells ran (outer
   method, inverse approximation and every option with its value in effect,
@@ -137,7 +138,7 @@ def status(study, binary=DEFAULT_BINARY):
     for c in cells:
         key = tuple(v for k, v in sorted(c.items()) if k in
                     ("scene", "solver", "eps", "scale", "threads", "frames_asked", "first_timed_frame", "set",
-                     "solver_opts")) if "id" in c else tuple(v for k, v in sorted(c.items()) if k not in measured)
+                     "solver_opts", "role", "sample_frames")) if "id" in c else tuple(v for k, v in sorted(c.items()) if k not in measured)
         settings[key] = settings.get(key, 0) + 1
     return {
         "study": os.path.basename(os.path.normpath(study)),

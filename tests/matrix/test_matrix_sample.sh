@@ -50,6 +50,10 @@ assert len(full) == len(part) > 0 and all(a[k] == b[k] for a, b in zip(full, par
 print("ok")
 PY
 check "sampled cells: the frames, the column, the writing solver's rows ($(tail -1 "$tmp/cmp"))" grep -qx ok "$tmp/cmp"
+# sauce's pn-pcg reference and its timed pn-pcg cell share scene, solver and eps: two roles, not two repeats
+reps=$(python3 "$src/scripts/study_status.py" --binary "$bin" --json "$tmp/r" 2>&1 |
+  python3 -c 'import json,sys; print(json.load(sys.stdin)[0]["repeats"])' 2>&1)
+check "study_status: a reference is not a repeat of its timed cell (repeats $reps)" test "$reps" = 1
 "$bin" matrix report "$tmp/r" >/dev/null 2>&1
 check "the report names the sampled frames" grep -q "Sampled frames .*sauce: 1,4,6" "$tmp/r/report.md"
 
