@@ -4,9 +4,11 @@
 # the file, or stops the run inside a frame, must see the finished steps.
 # The run is paused (SIGSTOP) once two step rows are on disk, inside frame 0
 # of about 200 steps: frames.csv then has no row yet, and steps.csv ends with
-# a whole row. Nothing here depends on how fast the machine is: a run that
-# wrote its step rows only at a frame's end would show them together with
-# frame 0's row.
+# a whole row. The checks follow files, not times: the poll (every 10 ms)
+# only has to see two rows before the run's ~200 steps of frame 0 end (about
+# 2.5 s alone, longer on a loaded machine, which slows the run as well). A
+# run that wrote its step rows only at a frame's end would show them
+# together with frame 0's row.
 . "$(dirname "$0")/../common/shell_harness.sh"
 data_rows() { # rows under the header (a file whose header is not on disk yet has none)
   local n=0
