@@ -204,6 +204,15 @@ def run_date(study):
     return provenance(study)[0]["start_time"][:10]
 
 
+def run_dates(study):
+    """The first and last day a study's runs started on ("D1 to D2", or one day), as its status line gives them."""
+    reads(study)
+    dates = study_state(study).get("dates") or []
+    if not dates:
+        raise Missing(f"results/{study}: no run records its date")
+    return " to ".join(sorted(set(dates)))
+
+
 def run_cpu(study):
     p = provenance(study)[0]
     return f"{p['cpu_model']}, {p['cores_online']} cores"
@@ -763,6 +772,9 @@ NUMBERS = {
     "bos.lead_2t_n": lambda: bos_lead(2, "n"),
     "bos.lead_1t": lambda: bos_lead(1),
     "bos.lead_1t_range": lambda: bos_lead(1, "range"),
+    **{f"paper.{tag}.cells": (lambda tag=tag: cells_ok(PAPER_PARTS[tag])) for tag in PAPER_PARTS},
+    **{f"paper.{tag}.date": (lambda tag=tag: run_dates(PAPER_PARTS[tag])) for tag in PAPER_PARTS},
+    **{f"paper.{tag}.minutes": (lambda tag=tag: cells_total_minutes(PAPER_PARTS[tag])) for tag in PAPER_PARTS},
     **{f"paper.{tag}.n_scenes": (lambda tag=tag: str(len(paper_part(tag).done))) for tag in PAPER_PARTS},
     **{f"paper.{tag}.scenes": (lambda tag=tag: ", ".join(paper_part(tag).done)) for tag in PAPER_PARTS},
     **{f"paper.{tag}.particles": (lambda tag=tag: paper_part_particles(tag)) for tag in PAPER_PARTS},

@@ -4,6 +4,7 @@ run of experiments/matrices/paper-scale.json:
 
     python3 scripts/paper_scale_table.py results/paper-scale > results/paper-scale/table.md
     python3 scripts/paper_scale_table.py PART_DIR PART_DIR ... > table.md
+    python3 scripts/paper_scale_table.py --out FILE PART_DIR ...   (FILE replaced only if the table is made)
     python3 scripts/paper_scale_table.py --rerun-bounds OLD_DIR NEW_DIR MPMBENCH
 
 Each scene's whole animation is simulated once by HOT (the reference run,
@@ -38,6 +39,7 @@ parts on different machines, each scene wholly on one, is given as several
 folders: one table, each scene's row naming its machine, and the summary
 (geometric means, ranks) once per machine, never pooled.
 """
+import contextlib
 import glob
 import json
 import os
@@ -489,12 +491,28 @@ def rerun_bounds(old, new, binary):
             mr.die(f"{run_json}: its rerun failed", 1)
 
 
+def write_table(out, dirs):
+    """main(dirs) into the file out, which is replaced only when the whole table is made: a part that
+    cannot join the others (another build or machine, a scene in two parts) leaves the old table."""
+    part = out + ".part"
+    try:
+        with open(part, "w") as f, contextlib.redirect_stdout(f):
+            main(dirs)
+    except BaseException:
+        if os.path.exists(part):
+            os.remove(part)
+        raise
+    os.replace(part, out)
+
+
 if __name__ == "__main__":
     if len(sys.argv) == 5 and sys.argv[1] == "--rerun-bounds":
         rerun_bounds(*sys.argv[2:])
+    elif len(sys.argv) >= 4 and sys.argv[1] == "--out":
+        write_table(sys.argv[2], sys.argv[3:])
     elif len(sys.argv) >= 2 and not sys.argv[1].startswith("-"):
         main(sys.argv[1:])
     else:
-        print("usage: paper_scale_table.py RESULTS_DIR [RESULTS_DIR ...] | --rerun-bounds OLD_DIR NEW_DIR MPMBENCH",
-              file=sys.stderr)
+        print("usage: paper_scale_table.py RESULTS_DIR [RESULTS_DIR ...] | --out FILE RESULTS_DIR [...]"
+              " | --rerun-bounds OLD_DIR NEW_DIR MPMBENCH", file=sys.stderr)
         sys.exit(2)

@@ -10,8 +10,8 @@
 # run the matrix excludes, stopped by its time limit (DIR/bounds/NAME/),
 # refusing one that timed other states or was not stopped, and a study whose runs
 # come from two machines (or whose timed runs come from two builds; a
-# reference from another build is named, its ratio left out), joining parts from two machines a scene each (and
-# scripts/fill_numbers.py quoting each part's numbers apart);
+# reference from another build is named, its ratio left out), joining parts from two machines a scene each (its
+# --out replacing a table only with one made, scripts/fill_numbers.py quoting each part's numbers and dates apart);
 # scripts/reproduce.sh remakes a study made in parts whole; other scenes run as before; a second
 # `matrix run` has nothing to do; the sampled frames are part of the ids;
 # a bad list, or first_timed_frame beside sample_frames, is a one-line
@@ -222,10 +222,21 @@ python3 "$src/scripts/paper_scale_table.py" "$tmp/pa" "$tmp/r" >/dev/null 2>"$tm
 rc=$?
 check "a scene in two parts: exit 2 ($(head -c 200 "$tmp/parts2.err"))" \
   bash -c "test $rc -eq 2 && grep -q \"$tmp/r: scene 'sauce' is also in $tmp/pa: a scene's runs come from one machine\" '$tmp/parts2.err'"
+# --out (scripts/reproduce.sh's way to remake table.md) writes the table made, and leaves the old file
+# when the parts cannot form one
+python3 "$src/scripts/paper_scale_table.py" --out "$tmp/out.md" "$tmp/pa" "$tmp/pb" 2>"$tmp/out.err"
+rc=$?
+check "--out: exit $rc, the same table as on stdout ($(head -c 200 "$tmp/out.err"))" \
+  bash -c "test $rc -eq 0 && cmp -s '$tmp/out.md' '$tmp/parts.md'"
+python3 "$src/scripts/paper_scale_table.py" --out "$tmp/out.md" "$tmp/pa" "$tmp/r" 2>"$tmp/out2.err"
+rc=$?
+check "--out with parts that cannot join: exit $rc, the old table kept, no .part left ($(head -c 200 "$tmp/out2.err"))" \
+  bash -c "test $rc -eq 2 && cmp -s '$tmp/out.md' '$tmp/parts.md' && test ! -e '$tmp/out.md.part'"
 
 # the numbers the pages quote from such a table (scripts/fill_numbers.py's paper.<part>.* keys) are
-# each part's own: its scenes, and HOT's lead over pn-pcg as that part's summary line gives it (the
-# parts' cells marked quiet here, so that a lead is claimed whatever the load of the machine testing)
+# each part's own: its scenes, its dates, and HOT's lead over pn-pcg as that part's summary line gives it (the
+# parts' cells marked quiet here, so that a lead is claimed whatever the load of the machine testing,
+# and one run of the first moved to an earlier day)
 python3 - "$tmp/pa" "$tmp/pb" <<'PY'
 import csv, sys
 for d in sys.argv[1:]:
@@ -234,6 +245,12 @@ for d in sys.argv[1:]:
         w = csv.DictWriter(f, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(dict(r, machine_busy="0") for r in rows)
+# one run of the first part started on an earlier day, so that its dates are a span
+import json
+run = f"{sys.argv[1]}/cells/{list(csv.DictReader(open(f'{sys.argv[1]}/cells.csv')))[0]['id']}/run.json"
+j = json.load(open(run))
+j["provenance"]["start_time"] = "2026-01-02T03:04:05Z"
+json.dump(j, open(run, "w"))
 PY
 python3 "$src/scripts/paper_scale_table.py" "$tmp/pa" "$tmp/pb" >"$tmp/quiet.md" 2>&1
 python3 - "$tmp" "$src/scripts" "$tmp/quiet.md" >"$tmp/keys.txt" 2>&1 <<'PY'
@@ -250,6 +267,13 @@ for tag, part, scene in (("epyc", "pa", "sauce"), ("xeon", "pb", "bar3")):
     quoted = float(f.value(f"paper.{tag}.pn-pcg_geomean")[0])
     assert abs(quoted - printed) <= 0.01 * printed, (tag, quoted, printed)
     assert f.value(f"paper.{tag}.pn-pcg_n")[0] == "1", f.value(f"paper.{tag}.pn-pcg_n")
+    # its dates: the first to the last day its runs started, read from the runs' own records
+    import csv, json
+    days = sorted({json.load(open(f"{tmp}/{part}/cells/{r['id']}/run.json"))["provenance"]["start_time"][:10]
+                   for r in csv.DictReader(open(f"{tmp}/{part}/cells.csv"))})
+    want = days[0] if days[0] == days[-1] else f"{days[0]} to {days[-1]}"
+    assert tag != "epyc" or days[0] == "2026-01-02", days
+    assert f.value(f"paper.{tag}.date")[0] == want, (tag, f.value(f"paper.{tag}.date"), want)
 print("ok")
 PY
 check "per-part keys: each part's scenes and its own lead over pn-pcg ($(tail -1 "$tmp/keys.txt"))" \
