@@ -1402,13 +1402,21 @@ DESCRIBED = [("threads", "thread", re.compile(r"(?<![\w.-])" + _NUM + r"[ -]thre
              ("scale", "scale", re.compile(r"(?:--scale|\bscale)[ =:]+" + _NUM + r"(?![\w.])", re.I))]
 
 
+def described_value(row, col):
+    """A cell's value of a DESCRIBED setting; a cell timing sampled frames ran as many frames as it
+    sampled (its frames_asked is the animation they were sampled from)."""
+    if col == "frames_asked" and row.get("sample_frames"):
+        return float(len(row["sample_frames"].split(",")))
+    return number(row.get(col))
+
+
 def description_conflicts(description, cells):
     """Settings the description states and no cell ran with: ['the description says 2 threads; the
     cells ran with 1 thread', ...]. A setting stated with several values (one of them matching) is
     no conflict; a count after "first" or "last" ("the first 2 frames") is not the setting."""
     notes = []
     for col, word, pattern in DESCRIBED:
-        have = {number(c.row.get(col)) for c in cells} - {0.0}
+        have = {described_value(c.row, col) for c in cells} - {0.0}
         have = {v for v in have if math.isfinite(v)}
         if not have:
             continue

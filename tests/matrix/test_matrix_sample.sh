@@ -54,8 +54,16 @@ check "sampled cells: the frames, the column, the writing solver's rows ($(tail 
 reps=$(python3 "$src/scripts/study_status.py" --binary "$bin" --json "$tmp/r" 2>&1 |
   python3 -c 'import json,sys; print(json.load(sys.stdin)[0]["repeats"])' 2>&1)
 check "study_status: a reference is not a repeat of its timed cell (repeats $reps)" test "$reps" = 1
+python3 - "$tmp/r/matrix.json" <<'PY'
+import json, sys
+m = json.load(open(sys.argv[1]))
+m["description"] = "Each sampled cell times three frames of the animation."
+json.dump(m, open(sys.argv[1], "w"))
+PY
 "$bin" matrix report "$tmp/r" >/dev/null 2>&1
 check "the report names the sampled frames" grep -q "Sampled frames .*sauce: 1,4,6" "$tmp/r/report.md"
+check "and finds a description of three frames true of the sampled cells (no 'Not as described')" \
+  bash -c "grep -q 'times three frames' '$tmp/r/report.md' && ! grep -q 'Not as described' '$tmp/r/report.md'"
 
 python3 "$src/scripts/paper_scale_table.py" "$tmp/r" >"$tmp/table0.md" 2>&1
 check "the table before the bound: sauce waits for it, not for the matrix" \
