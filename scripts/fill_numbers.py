@@ -512,25 +512,9 @@ def fig18_speedup(scene, solver="gast15"):
     return sig(num(one("gast15-fig18", scene=scene, solver=solver), "speedup_total"))
 
 
-def paper_scenes():
-    """Scenes of the paper-scale matrix with every solver's cell present."""
-    rows = [r for r in table("paper-scale", "cells.csv") if r.get("role", "") != "reference"]
-    solvers = {r["solver"] for r in rows}
-    by = {}
-    for r in rows:
-        by.setdefault(r["scene"], set()).add(r["solver"])
-    return [sc for sc, s in by.items() if s == solvers]
-
-
-def paper_particles():
-    parts = [num(r, "particles") for r in table("paper-scale", "cells.csv") if r["scene"] in paper_scenes()]
-    return f"{grouped(min(parts))} to {grouped(max(parts))}"
-
-
-# The like-for-like Table 1 runs in two parts, each scene wholly on one machine; a part's numbers are
-# never pooled with the other's (scripts/paper_scale_table.py), so every key names its part. While the
-# parts are under way (results/paper-scale*.new, issue 28) no page quotes these keys.
-PAPER_PARTS = {"epyc": "paper-scale.new", "xeon": "paper-scale-xeon.new"}
+# The like-for-like Table 1 ran in two parts, each scene wholly on one machine; a part's numbers are
+# never pooled with the other's (scripts/paper_scale_table.py), so every key names its part.
+PAPER_PARTS = {"epyc": "paper-scale", "xeon": "paper-scale-xeon"}
 PAPER_RIVALS = ["pn-pcg", "pn-pcg-mf", "pn-mgpcg", "lbfgs-h", "lbfgs-ml"]
 
 
@@ -787,13 +771,6 @@ NUMBERS = {
        for tag in PAPER_PARTS for so in PAPER_RIVALS},
     **{f"paper.{tag}.{so}_{what}": (lambda tag=tag, so=so, what=what: paper_part_lead(tag, so, what))
        for tag in PAPER_PARTS for so in PAPER_RIVALS for what in ("geomean", "range", "n")},
-    "paper.cells": lambda: cells_ok("paper-scale"),
-    "paper.date": lambda: run_date("paper-scale"),
-    "paper.n_scenes": lambda: str(len(paper_scenes())),
-    "paper.particles": paper_particles,
-    "paper.hot_geomean": lambda: geomean("paper-scale", "hot"),
-    "paper.hot_range": lambda: speedup_range("paper-scale", "hot"),
-    "paper.mf_geomean": lambda: geomean("paper-scale", "pn-pcg-mf"),
     "sp.cells": lambda: cells_ok("smoother-precision"),
     "sp.date": lambda: run_date("smoother-precision"),
     "sp.hot": lambda: smoother_ratio("hot"),
